@@ -71,7 +71,9 @@ int run_fly(const FlyOptions& o) {
   auto profile = o.profile.empty() ? control::GestureProfile::builtin_default()
                                    : control::GestureProfile::load_file(o.profile);
 
-  contracts::ManualClock manual_clock;
+  // Simulated time starts at the real UTC now, so a recorded session carries today's date.
+  contracts::ManualClock manual_clock(
+      std::chrono::time_point_cast<std::chrono::milliseconds>(std::chrono::system_clock::now()));
   contracts::SteadyClock steady_clock;
   const contracts::Clock& clock =
       o.realtime ? static_cast<const contracts::Clock&>(steady_clock) : manual_clock;
@@ -88,6 +90,12 @@ int run_fly(const FlyOptions& o) {
     so.path = o.db;
     storage = std::make_unique<storage::StorageManager>(so, clock);
     storage->end_open_sessions();
+    const auto retention = storage->apply_retention();
+    if (retention.sessions_deleted > 0 || retention.telemetry_rows_deleted > 0) {
+      std::cout << "gbdcs fly: retention removed " << retention.sessions_deleted
+                << " old sessions and " << retention.telemetry_rows_deleted
+                << " old telemetry rows from " << o.db << "\n";
+    }
     session_id = storage->begin_session(std::nullopt, o.adapter, profile.name);
     loop.add_listener(std::make_shared<runtime::StorageListener>(
         *storage, session_id, [](const std::string& e) { std::cerr << e << "\n"; }));
