@@ -1,5 +1,7 @@
 #include "gbdcs/adapters/dummy_adapter.hpp"
 
+#include "gbdcs/contracts/json_options.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -17,26 +19,28 @@ constexpr double kGravityM_s2 = 9.81;
 
 DummyOptions DummyOptions::from_json(const nlohmann::json& doc) {
   DummyOptions o;
-  if (!doc.is_object()) throw std::invalid_argument("dummy options: expected a JSON object");
-  for (const auto& [key, value] : doc.items()) {
-    double* field = nullptr;
-    if (key == "telemetry_hz") field = &o.telemetry_hz;
-    else if (key == "takeoff_altitude_m") field = &o.takeoff_altitude_m;
-    else if (key == "climb_m_s") field = &o.climb_m_s;
-    else if (key == "land_m_s") field = &o.land_m_s;
-    else if (key == "max_speed_m_s") field = &o.max_speed_m_s;
-    else if (key == "battery_start_pct") field = &o.battery_start_pct;
-    else if (key == "drain_idle_pct_s") field = &o.drain_idle_pct_s;
-    else if (key == "drain_flying_pct_s") field = &o.drain_flying_pct_s;
-    else if (key == "crash_speed_m_s") field = &o.crash_speed_m_s;
-    if (!field) throw std::invalid_argument("dummy options: unknown key '" + key + "'");
-    if (!value.is_number() || value.get<double>() < 0) {
-      throw std::invalid_argument("dummy options: '" + key + "' must be a non-negative number");
-    }
-    *field = value.get<double>();
+  contracts::JsonOptionReader r(doc, "dummy options");
+  r.read("telemetry_hz", o.telemetry_hz);
+  r.read("takeoff_altitude_m", o.takeoff_altitude_m);
+  r.read("climb_m_s", o.climb_m_s);
+  r.read("land_m_s", o.land_m_s);
+  r.read("max_speed_m_s", o.max_speed_m_s);
+  r.read("battery_start_pct", o.battery_start_pct);
+  r.read("drain_idle_pct_s", o.drain_idle_pct_s);
+  r.read("drain_flying_pct_s", o.drain_flying_pct_s);
+  r.read("crash_speed_m_s", o.crash_speed_m_s);
+  r.finish();
+  const std::string owner = "dummy options";
+  contracts::require(o.telemetry_hz >= 5 && o.telemetry_hz <= 100, owner, "telemetry_hz",
+                     "must be within [5, 100]");
+  contracts::require(o.battery_start_pct >= 0 && o.battery_start_pct <= 100, owner,
+                     "battery_start_pct", "must be within [0, 100]");
+  for (double v : {o.takeoff_altitude_m, o.climb_m_s, o.land_m_s, o.max_speed_m_s,
+                   o.crash_speed_m_s}) {
+    contracts::require(v > 0, owner, "speeds and altitudes", "must be positive");
   }
-  if (o.telemetry_hz < 5) throw std::invalid_argument("dummy options: telemetry_hz must be >= 5");
-  o.battery_start_pct = std::min(o.battery_start_pct, 100.0);
+  contracts::require(o.drain_idle_pct_s >= 0 && o.drain_flying_pct_s >= 0, owner, "drain_*",
+                     "must not be negative");
   return o;
 }
 

@@ -6,7 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
-#include "json_options.hpp"
+#include "gbdcs/contracts/json_options.hpp"
 
 namespace gbdcs::gesture {
 namespace {
@@ -22,7 +22,7 @@ std::size_t slot(GestureType g) { return static_cast<std::size_t>(g); }
 
 GestureEngineOptions gesture_engine_options_from_json(const nlohmann::json& doc) {
   GestureEngineOptions o;
-  detail::JsonOptionReader r(doc, kOwner);
+  contracts::JsonOptionReader r(doc, kOwner);
   r.read("window_frames", o.window_frames);
   r.read("agree_frames", o.agree_frames);
   r.read("release_frames", o.release_frames);
@@ -42,7 +42,7 @@ nlohmann::json to_json(const GestureEngineOptions& o) {
 }
 
 void validate(const GestureEngineOptions& o) {
-  using detail::require;
+  using contracts::require;
   require(o.window_frames >= 1 && o.window_frames <= kMaxWindowFrames, kOwner, "window_frames",
           "must be in [1, " + std::to_string(kMaxWindowFrames) + "]");
   require(o.agree_frames >= 1 && o.agree_frames <= o.window_frames, kOwner, "agree_frames",

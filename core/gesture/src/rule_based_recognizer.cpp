@@ -6,7 +6,7 @@
 #include <optional>
 #include <string>
 
-#include "json_options.hpp"
+#include "gbdcs/contracts/json_options.hpp"
 
 namespace gbdcs::gesture {
 namespace {
@@ -75,7 +75,7 @@ std::optional<Recognition> match_direction(double direction_deg, double in_plane
 
 RuleBasedOptions rule_based_options_from_json(const nlohmann::json& doc) {
   RuleBasedOptions o;
-  detail::JsonOptionReader r(doc, kOwner);
+  contracts::JsonOptionReader r(doc, kOwner);
   r.read("aspect_ratio", o.aspect_ratio);
   r.read("depth_weight", o.depth_weight);
   r.read("finger_extended_max_curl_deg", o.finger_extended_max_curl_deg);
@@ -115,9 +115,9 @@ nlohmann::json to_json(const RuleBasedOptions& o) {
 void validate(const RuleBasedOptions& o) {
   const nlohmann::json all = to_json(o);
   for (const auto& [key, value] : all.items()) {
-    detail::require(std::isfinite(value.get<double>()), kOwner, key, "must be finite");
+    contracts::require(std::isfinite(value.get<double>()), kOwner, key, "must be finite");
   }
-  using detail::require;
+  using contracts::require;
   require(o.aspect_ratio > 0, kOwner, "aspect_ratio", "must be > 0 (frame width / height)");
   require(o.depth_weight >= 0 && o.depth_weight <= 1, kOwner, "depth_weight",
           "must be in [0, 1]");

@@ -1,5 +1,7 @@
 #include "gbdcs/telemetry/failsafe_monitor.hpp"
 
+#include "gbdcs/contracts/json_options.hpp"
+
 #include <cmath>
 #include <stdexcept>
 
@@ -11,23 +13,19 @@ using contracts::Severity;
 
 FailsafeOptions FailsafeOptions::from_json(const nlohmann::json& doc) {
   FailsafeOptions o;
-  if (!doc.is_object()) throw std::invalid_argument("failsafe options: expected a JSON object");
-  for (const auto& [key, value] : doc.items()) {
-    double* field = nullptr;
-    if (key == "link_timeout_s") field = &o.link_timeout_s;
-    else if (key == "idle_timeout_s") field = &o.idle_timeout_s;
-    else if (key == "battery_warn_pct") field = &o.battery_warn_pct;
-    else if (key == "battery_land_pct") field = &o.battery_land_pct;
-    if (!field) throw std::invalid_argument("failsafe options: unknown key '" + key + "'");
-    if (!value.is_number() || value.get<double>() <= 0) {
-      throw std::invalid_argument("failsafe options: '" + key + "' must be a positive number");
-    }
-    *field = value.get<double>();
-  }
-  if (o.battery_land_pct >= o.battery_warn_pct) {
-    throw std::invalid_argument(
-        "failsafe options: battery_land_pct must be below battery_warn_pct");
-  }
+  const std::string owner = "failsafe options";
+  contracts::JsonOptionReader r(doc, owner);
+  r.read("link_timeout_s", o.link_timeout_s);
+  r.read("idle_timeout_s", o.idle_timeout_s);
+  r.read("battery_warn_pct", o.battery_warn_pct);
+  r.read("battery_land_pct", o.battery_land_pct);
+  r.finish();
+  contracts::require(o.link_timeout_s > 0, owner, "link_timeout_s", "must be positive");
+  contracts::require(o.idle_timeout_s > 0, owner, "idle_timeout_s", "must be positive");
+  contracts::require(o.battery_land_pct > 0 && o.battery_land_pct < o.battery_warn_pct &&
+                         o.battery_warn_pct <= 100,
+                     owner, "battery_land_pct",
+                     "must be positive and below battery_warn_pct (which is at most 100)");
   return o;
 }
 

@@ -1,10 +1,10 @@
-#include "json_options.hpp"
+#include "gbdcs/contracts/json_options.hpp"
 
 #include <algorithm>
 #include <cstdint>
 #include <stdexcept>
 
-namespace gbdcs::gesture::detail {
+namespace gbdcs::contracts {
 
 JsonOptionReader::JsonOptionReader(const nlohmann::json& doc, std::string owner)
     : doc_(doc), owner_(std::move(owner)) {
@@ -54,4 +54,4 @@ void require(bool ok, const std::string& owner, const std::string& key,
   if (!ok) throw std::invalid_argument(owner + ": '" + key + "' " + problem);
 }
 
-}  // namespace gbdcs::gesture::detail
+}  // namespace gbdcs::contracts

@@ -1,5 +1,5 @@
 // Reads an options struct from a JSON object, key by key, and rejects what it does not know.
-// Private to core/gesture.
+// Used by every options struct in the core and the adapters.
 #pragma once
 
 #include <nlohmann/json.hpp>
@@ -7,7 +7,7 @@
 #include <string_view>
 #include <vector>
 
-namespace gbdcs::gesture::detail {
+namespace gbdcs::contracts {
 
 // Each read() takes a key if present (absent keys keep the struct's default); finish() throws
 // std::invalid_argument naming any key that no read() asked for. Every message starts with
@@ -31,4 +31,4 @@ class JsonOptionReader {
 void require(bool ok, const std::string& owner, const std::string& key,
              const std::string& problem);
 
-}  // namespace gbdcs::gesture::detail
+}  // namespace gbdcs::contracts
