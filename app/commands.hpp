@@ -13,5 +13,7 @@ void add_version_command(CLI::App& app);
 void add_fly_command(CLI::App& app);
 void add_profile_command(CLI::App& app);
 void add_schema_command(CLI::App& app);
+// vision, recognize, bench (vision), eval (landmarks): vision_commands.cpp
+void add_vision_commands(CLI::App& app);
 
 }  // namespace gbdcs::app

@@ -13,6 +13,7 @@ int main(int argc, char** argv) {
   gbdcs::app::add_fly_command(app);
   gbdcs::app::add_profile_command(app);
   gbdcs::app::add_schema_command(app);
+  gbdcs::app::add_vision_commands(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,0 +1,322 @@
+// Vision subcommands: `vision` (the worker: pipeline -> JSON lines), `recognize` (hands and
+// gestures in images or videos), `eval landmarks` (ours against the MediaPipe reference).
+// `bench vision` is in vision_bench_command.cpp.
+#include <atomic>
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <mutex>
+#include <opencv2/core/utils/logger.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <sstream>
+
+#include "commands.hpp"
+#include "gbdcs/contracts/codec.hpp"
+#include "gbdcs/vision/model_files.hpp"
+#include "gbdcs/vision/vision_messages.hpp"
+#include "gbdcs/vision/vision_pipeline.hpp"
+#include "vision_support.hpp"
+
+namespace gbdcs::app {
+namespace {
+
+using nlohmann::json;
+
+std::atomic<bool> g_interrupted{false};
+void on_signal(int) {
+  g_interrupted = true;
+}
+
+// OpenCV's own warnings (backends it tried) would bury our one clear message.
+void quiet_opencv() {
+  cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_ERROR);
+}
+
+json read_json_file(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(path + ": cannot read (check the path)");
+  std::stringstream text;
+  text << in.rdbuf();
+  try {
+    return contracts::parse_json(text.str());
+  } catch (const std::exception& e) {
+    throw std::runtime_error(path + ": " + e.what());
+  }
+}
+
+// ---- gbdcs vision -----------------------------------------------------------------------
+struct VisionOptions {
+  std::string source;
+  ModelChoice models;
+  std::string publish;
+  std::string options_file;
+  double heartbeat_s = 1.0;
+};
+
+int run_vision(const VisionOptions& o) {
+  if (!o.publish.empty()) {
+    std::cerr << "gbdcs vision: --publish " << o.publish
+              << " is not available until the server lands (the WebSocket comes with it); "
+                 "leave --publish out to get the same messages as JSON lines on stdout\n";
+    return 2;
+  }
+  quiet_opencv();
+  contracts::SteadyClock clock;
+  vision::PipelineOptions options;
+  if (!o.options_file.empty())
+    options = vision::pipeline_options_from_json(read_json_file(o.options_file));
+  std::unique_ptr<vision::CaptureSource> source;
+  std::unique_ptr<vision::HandFinder> finder;
+  try {
+    source = vision::open_source(o.source, clock);
+    // A folder holds unrelated stills: detect in each (MediaPipe's static image mode).
+    const bool stills = o.source.rfind("images:", 0) == 0;
+    finder = vision::make_tracker_finder(tracker_options(o.models, stills), clock);
+  } catch (const vision::CaptureError& e) {
+    std::cerr << "gbdcs vision: " << e.what() << "\n";
+    return 2;
+  } catch (const vision::ModelError& e) {
+    std::cerr << "gbdcs vision: " << e.what() << "\n";
+    return 2;
+  }
+
+  std::mutex out_mutex;
+  auto emit = [&](const json& doc) {
+    std::lock_guard lock(out_mutex);
+    std::cout << doc.dump() << '\n' << std::flush;
+  };
+  vision::VisionPipeline pipeline(
+      std::move(source), std::move(finder), clock,
+      [&](const vision::FrameResult& r) { emit(vision::frame_message(r)); }, options);
+
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+  pipeline.start();
+  const auto period = contracts::from_seconds(o.heartbeat_s);
+  auto next_beat = clock.now() + period;
+  bool finished = false;
+  while (!finished && !g_interrupted) {
+    finished = pipeline.wait_for(std::chrono::milliseconds(50));
+    if (clock.now() >= next_beat) {
+      emit(vision::heartbeat_message(pipeline.metrics(), clock.utc_now()));
+      next_beat += period;
+    }
+  }
+  pipeline.stop();
+  const auto m = pipeline.metrics();
+  emit(vision::heartbeat_message(m, clock.utc_now()));
+  if (!m.healthy) {
+    std::cerr << "gbdcs vision: " << m.reason << "\n";
+    return 1;
+  }
+  return 0;
+}
+
+// ---- gbdcs recognize ----------------------------------------------------------------------
+struct RecognizeOptions {
+  std::vector<std::string> files;
+  bool json = false;
+  ModelChoice models;
+};
+
+constexpr const char* kLandmarkNames[contracts::kLandmarkCount] = {
+    "wrist",     "thumb_cmc", "thumb_mcp",  "thumb_ip",   "thumb_tip",  "index_mcp",  "index_pip",
+    "index_dip", "index_tip", "middle_mcp", "middle_pip", "middle_dip", "middle_tip", "ring_mcp",
+    "ring_pip",  "ring_dip",  "ring_tip",   "pinky_mcp",  "pinky_pip",  "pinky_dip",  "pinky_tip"};
+
+void print_text(const vision::RecognizedImage& r, bool video) {
+  std::cout << r.image;
+  if (video) std::cout << " frame " << r.frame;
+  std::cout << " (" << r.width << "x" << r.height << "): " << r.hands.size()
+            << (r.hands.size() == 1 ? " hand\n" : " hands\n");
+  for (std::size_t i = 0; i < r.hands.size(); ++i) {
+    const auto& h = r.hands[i];
+    std::cout << std::fixed << std::setprecision(3) << "  hand " << i << ": "
+              << contracts::to_string(h.landmarks.handedness) << ", presence " << h.landmarks.score
+              << ", gesture " << contracts::to_string(h.gesture) << " (" << h.confidence << ")\n";
+    for (std::size_t k = 0; k < contracts::kLandmarkCount; ++k) {
+      const auto& p = h.landmarks.points[k];
+      std::cout << std::setprecision(4) << "    " << std::setw(2) << k << " " << std::left
+                << std::setw(11) << kLandmarkNames[k] << std::right << " x " << p.x << "  y " << p.y
+                << "  z " << std::showpos << p.z << std::noshowpos << "\n";
+    }
+  }
+  std::cout.unsetf(std::ios::floatfield);
+}
+
+vision::RecognizedImage recognize_frame(vision::HandFinder& finder,
+                                        vision::HandClassifier& classifier, const cv::Mat& bgr,
+                                        const std::string& name, std::int64_t frame) {
+  cv::Mat rgb;
+  cv::cvtColor(bgr, rgb, cv::COLOR_BGR2RGB);
+  vision::RecognizedImage r;
+  r.image = name;
+  r.frame = frame;
+  r.width = rgb.cols;
+  r.height = rgb.rows;
+  classifier.set_frame_size(rgb.cols, rgb.rows);
+  r.hands = classifier.classify(finder.find(rgb));
+  return r;
+}
+
+int run_recognize(const RecognizeOptions& o) {
+  quiet_opencv();
+  contracts::SteadyClock clock;
+  std::unique_ptr<vision::HandFinder> stills;  // static image mode, made when first needed
+  std::unique_ptr<vision::HandFinder> video;   // tracking mode, reset for each video
+  vision::HandClassifier classifier;
+  json all = json::array();
+  int failures = 0;
+  auto out = [&](const vision::RecognizedImage& r, bool is_video) {
+    if (o.json) {
+      all.push_back(vision::to_json(r));
+    } else {
+      print_text(r, is_video);
+    }
+  };
+  for (const auto& file : o.files) {
+    try {
+      if (std::error_code ec; !std::filesystem::is_regular_file(file, ec)) {
+        throw std::runtime_error("no such file (check the path)");
+      }
+      if (vision::is_image_file(file)) {
+        cv::Mat bgr = cv::imread(file, cv::IMREAD_COLOR);
+        if (bgr.empty())
+          throw vision::CaptureError("cannot decode the image (damaged, or not an image?)");
+        if (!stills) stills = vision::make_tracker_finder(tracker_options(o.models, true), clock);
+        out(recognize_frame(*stills, classifier, bgr, file, 0), false);
+        continue;
+      }
+      auto source = vision::open_video(file, clock);
+      if (!video) video = vision::make_tracker_finder(tracker_options(o.models, false), clock);
+      video->reset();
+      while (auto frame = source->next()) {
+        out(recognize_frame(*video, classifier, frame->rgb, file, frame->frame_id), true);
+      }
+    } catch (const vision::ModelError& e) {
+      std::cerr << "gbdcs recognize: " << e.what() << "\n";
+      return 2;
+    } catch (const std::exception& e) {
+      std::cerr << "gbdcs recognize: " << file << ": " << e.what() << "\n";
+      ++failures;
+    }
+  }
+  if (o.json) std::cout << all.dump(1) << "\n";
+  return failures == 0 ? 0 : 1;
+}
+
+// ---- gbdcs eval landmarks ---------------------------------------------------------------
+struct EvalOptions {
+  std::string ours;
+  std::string ref;
+  bool json = false;
+  double max_mean_pct = 1.5;
+};
+
+std::string pct(const std::optional<double>& v) {
+  if (!v) return "-";
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(2) << *v << " %";
+  return s.str();
+}
+
+int run_eval_landmarks(const EvalOptions& o) {
+  const auto ours = vision::recognized_from_json(read_json_file(o.ours));
+  const auto ref = vision::recognized_from_json(read_json_file(o.ref));
+  const auto c = vision::compare_landmarks(ours, ref);
+  const bool detection_ok = c.hands_only_ours == 0 && c.hands_only_ref == 0;
+  const bool accuracy_ok = !c.mean_distance_pct || *c.mean_distance_pct <= o.max_mean_pct;
+  const bool pass = detection_ok && accuracy_ok && !c.images.empty();
+  if (o.json) {
+    auto doc = vision::to_json(c);
+    doc["max_mean_pct"] = o.max_mean_pct;
+    doc["pass"] = pass;
+    std::cout << doc.dump(1) << "\n";
+  } else {
+    for (const auto& i : c.images) {
+      std::cout << std::left << std::setw(40) << i.image << std::right << " hands ours "
+                << i.hands_ours << " ref " << i.hands_ref << "  mean distance " << std::setw(8)
+                << pct(i.mean_distance_pct) << (i.detection_agrees ? "" : "  DETECTION DIFFERS")
+                << "\n";
+    }
+    for (const auto& k : c.only_in_ref) std::cout << k << ": only in " << o.ref << "\n";
+    for (const auto& k : c.only_in_ours) std::cout << k << ": only in " << o.ours << "\n";
+    std::cout << "images compared " << c.images.size() << ", detection agrees on "
+              << c.images_detection_agree << "; hands matched " << c.hands_matched << ", missed "
+              << c.hands_only_ref << ", extra " << c.hands_only_ours << "\nmean landmark distance "
+              << pct(c.mean_distance_pct) << " (limit " << o.max_mean_pct << " %), worst hand "
+              << pct(c.max_distance_pct) << ", worst landmark " << pct(c.max_landmark_distance_pct)
+              << " of the hand's "
+              << "bounding-box diagonal\n"
+              << (pass ? "PASS" : "FAIL") << "\n";
+  }
+  return pass ? 0 : 1;
+}
+
+// Runs `body`, turning an exception into a message and exit code 2.
+void guarded(const char* name, const std::function<int()>& body) {
+  try {
+    g_exit_code = body();
+  } catch (const std::exception& e) {
+    std::cerr << "gbdcs " << name << ": " << e.what() << "\n";
+    g_exit_code = 2;
+  }
+}
+
+}  // namespace
+
+void add_vision_commands(CLI::App& app) {
+  static VisionOptions v;
+  auto* vision_cmd = app.add_subcommand(
+      "vision",
+      "Run the vision pipeline (capture -> landmarks -> gesture) on a camera, video or image "
+      "folder; prints JSON lines: a frame message per frame, a heartbeat every second");
+  vision_cmd->add_option("--source", v.source, "camera:N, video:PATH or images:DIR")->required();
+  add_model_options(vision_cmd, v.models);
+  vision_cmd->add_option("--publish", v.publish,
+                         "WebSocket URL to publish to (not available until the server lands)");
+  vision_cmd->add_option("--options", v.options_file,
+                         "PipelineOptions JSON (queue_capacity, policy, resize_width, ...; "
+                         "docs/VISION.md)");
+  vision_cmd->add_option("--heartbeat", v.heartbeat_s, "Seconds between heartbeats")
+      ->capture_default_str()
+      ->check(CLI::Range(0.05, 60.0));
+  vision_cmd->callback([] { guarded("vision", [] { return run_vision(v); }); });
+
+  static RecognizeOptions r;
+  auto* recognize = app.add_subcommand(
+      "recognize",
+      "Find hands in images (each on its own) or videos (tracked frame to frame): 21 "
+      "landmarks, handedness, presence and the recognised gesture");
+  recognize->add_option("FILES", r.files, "Images (.jpg .png ...) or videos")->required();
+  recognize->add_flag("--json", r.json, "One JSON array, an object per image or video frame");
+  add_model_options(recognize, r.models);
+  recognize->callback([] { guarded("recognize", [] { return run_recognize(r); }); });
+
+  auto* bench = app.add_subcommand("bench", "Benchmarks");
+  bench->require_subcommand(1);
+  add_bench_vision_command(*bench);
+
+  static EvalOptions e;
+  auto* eval = app.add_subcommand("eval", "Compare results against a reference");
+  eval->require_subcommand(1);
+  auto* landmarks = eval->add_subcommand(
+      "landmarks",
+      "Compare two `recognize --json` files (ours, and the MediaPipe reference's): per image "
+      "the mean landmark distance as % of the hand's bounding-box diagonal, and whether both "
+      "found the same hands. Exit 0 when every hand agrees and the mean is within the limit");
+  landmarks->add_option("OURS", e.ours, "Our recognize --json output")->required();
+  landmarks->add_option("REF", e.ref, "The reference's output (mediapipe-reference/run)")
+      ->required();
+  landmarks->add_flag("--json", e.json, "One JSON object");
+  landmarks
+      ->add_option("--max-mean-pct", e.max_mean_pct,
+                   "Limit on the overall mean distance, % of the bbox diagonal")
+      ->capture_default_str();
+  landmarks->callback([] { guarded("eval landmarks", [] { return run_eval_landmarks(e); }); });
+}
+
+}  // namespace gbdcs::app
