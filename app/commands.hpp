@@ -15,5 +15,7 @@ void add_profile_command(CLI::App& app);
 void add_schema_command(CLI::App& app);
 // vision, recognize, bench (vision), eval (landmarks): vision_commands.cpp
 void add_vision_commands(CLI::App& app);
+// twin, bench twin: twin_command.cpp (registered after add_vision_commands)
+void add_twin_command(CLI::App& app);
 
 }  // namespace gbdcs::app

@@ -7,7 +7,7 @@
 #include <thread>
 
 #include "commands.hpp"
-#include "gbdcs/adapters/registry.hpp"
+#include "drone_factory.hpp"
 #include "gbdcs/contracts/codec.hpp"
 #include "gbdcs/gesture/gesture_engine.hpp"
 #include "gbdcs/gesture/rule_based_recognizer.hpp"
@@ -78,7 +78,7 @@ int run_fly(const FlyOptions& o) {
   const contracts::Clock& clock =
       o.realtime ? static_cast<const contracts::Clock&>(steady_clock) : manual_clock;
 
-  auto adapter = adapters::make_adapter(o.adapter, clock);
+  auto adapter = make_drone(o.adapter, clock);
   gesture::GestureEngine engine(clock, std::make_unique<gesture::RuleBasedRecognizer>());
   control::CommandTranslator translator(profile);
   runtime::ControlLoop loop(clock, *adapter, engine, translator);

@@ -14,6 +14,7 @@ int main(int argc, char** argv) {
   gbdcs::app::add_profile_command(app);
   gbdcs::app::add_schema_command(app);
   gbdcs::app::add_vision_commands(app);
+  gbdcs::app::add_twin_command(app);  // after vision: it adds `bench twin` to `bench`
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
