@@ -12,6 +12,7 @@
 #include <thread>
 #include <vector>
 
+#include "command_registry.hpp"
 #include "commands.hpp"
 #include "gbdcs/contracts/codec.hpp"
 #include "gbdcs/sim/command_script.hpp"
@@ -208,14 +209,6 @@ int run_bench_twin(const BenchTwinOptions& o) {
   return 0;
 }
 
-CLI::App* bench_command(CLI::App& app) {
-  auto found = app.get_subcommands([](CLI::App* a) { return a->get_name() == "bench"; });
-  if (!found.empty()) return found.front();
-  auto* bench = app.add_subcommand("bench", "Benchmarks");
-  bench->require_subcommand(1);
-  return bench;
-}
-
 }  // namespace
 
 void add_twin_command(CLI::App& app) {
@@ -252,7 +245,7 @@ void add_twin_command(CLI::App& app) {
   });
 
   static BenchTwinOptions b;
-  auto* bench = bench_command(app)->add_subcommand(
+  auto* bench = group_command(app, "bench", "Benchmarks")->add_subcommand(
       "twin",
       "Twin physics speed (sim s per wall s, one thread, no rendering) and 640x480 "
       "render time");

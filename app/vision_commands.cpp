@@ -13,6 +13,7 @@
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 
+#include "command_registry.hpp"
 #include "commands.hpp"
 #include "gbdcs/contracts/codec.hpp"
 #include "gbdcs/vision/model_files.hpp"
@@ -296,13 +297,10 @@ void add_vision_commands(CLI::App& app) {
   add_model_options(recognize, r.models);
   recognize->callback([] { guarded("recognize", [] { return run_recognize(r); }); });
 
-  auto* bench = app.add_subcommand("bench", "Benchmarks");
-  bench->require_subcommand(1);
-  add_bench_vision_command(*bench);
+  add_bench_vision_command(*group_command(app, "bench", "Benchmarks"));
 
   static EvalOptions e;
-  auto* eval = app.add_subcommand("eval", "Compare results against a reference");
-  eval->require_subcommand(1);
+  auto* eval = group_command(app, "eval", "Compare results against a reference");
   auto* landmarks = eval->add_subcommand(
       "landmarks",
       "Compare two `recognize --json` files (ours, and the MediaPipe reference's): per image "

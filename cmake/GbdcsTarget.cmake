@@ -31,3 +31,24 @@ function(gbdcs_embed_files out_cpp namespace)
   set(content "${content}  };\n}\n}  // namespace ${namespace}\n")
   file(GENERATE OUTPUT ${out_cpp} CONTENT "${content}")
 endfunction()
+
+# gbdcs_add_subfolders(): add_subdirectory for every child folder that has a CMakeLists.txt,
+# so a new component is one new folder and no shared list to edit. Target names resolve at
+# generate time, so the order of folders does not matter.
+function(gbdcs_add_subfolders)
+  file(GLOB children LIST_DIRECTORIES true RELATIVE ${CMAKE_CURRENT_SOURCE_DIR}
+       ${CMAKE_CURRENT_SOURCE_DIR}/*)
+  list(SORT children)
+  foreach(child IN LISTS children)
+    if(IS_DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}/${child}
+       AND EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/${child}/CMakeLists.txt)
+      add_subdirectory(${child})
+    endif()
+  endforeach()
+endfunction()
+
+# gbdcs_app_uses(target...): link these libraries into the gbdcs binary (app/ reads the list),
+# so a component that brings a subcommand registers its library from its own folder.
+function(gbdcs_app_uses)
+  set_property(GLOBAL APPEND PROPERTY GBDCS_APP_LIBS ${ARGN})
+endfunction()
