@@ -15,6 +15,203 @@ export type Alert = {
 
 export const ALERT_SEVERITY = ["INFO","WARNING","CRITICAL"] as const;
 
+/** A logged alert; alert.id is the id to acknowledge.
+ * Schema: core/contracts/schemas/api_alert_record.schema.json */
+export type AlertRecord = {
+  alert: Alert;
+  acknowledged_at: null | string;
+};
+
+/** A logged command with its outcome (OK, an adapter result, REFUSED: why, DROPPED: why).
+ * Schema: core/contracts/schemas/api_command_record.schema.json */
+export type CommandRecord = {
+  command: DroneCommand;
+  outcome: string;
+  /** UTC, ISO 8601 with milliseconds and Z */
+  recorded_at: string;
+};
+
+/** GET /api/v1/config and the answer to PUT: the gesture -> command mapping, the caller's theme, the active adapter and what can be chosen.
+ * Schema: core/contracts/schemas/api_config.schema.json */
+export type Config = {
+  profile: GestureProfile;
+  /** per user */
+  theme: "light" | "dark";
+  adapter: {
+    /** dummy, twin, tello, airsim, xfly (GET /config lists the available ones) */
+    name: string;
+    /** adapter options (docs/ADAPTERS.md), e.g. {"address": "192.168.10.1"} */
+    options: Record<string, unknown>;
+  };
+  adapters_available: string[];
+  /** the vision worker's camera source (read-only here; set with serve --source) */
+  source: string;
+};
+
+export const CONFIG_THEME = ["light","dark"] as const;
+
+/** PUT /api/v1/config: any of profile, theme, adapter. Changing the adapter disconnects the old drone first (it is told to land if flying), then connects the new one and opens a new session.
+ * Schema: core/contracts/schemas/api_config_update.schema.json */
+export type ConfigUpdate = {
+  profile?: GestureProfile;
+  theme?: "light" | "dark";
+  adapter?: {
+    /** dummy, twin, tello, airsim, xfly (GET /config lists the available ones) */
+    name: string;
+    /** adapter options (docs/ADAPTERS.md), e.g. {"address": "192.168.10.1"} */
+    options: Record<string, unknown>;
+  };
+};
+
+export const CONFIG_UPDATE_THEME = ["light","dark"] as const;
+
+/** Answer to POST /control/emergency-stop and /control/emergency-reset.
+ * Schema: core/contracts/schemas/api_control_state.schema.json */
+export type ControlState = {
+  accepted: boolean;
+  /** OK, or why not */
+  outcome: string;
+  /** true: every command but a reset is refused */
+  emergency_latched: boolean;
+  command_id: null | number;
+};
+
+/** POST /api/v1/control/emergency-stop (body optional).
+ * Schema: core/contracts/schemas/api_emergency_stop_request.schema.json */
+export type EmergencyStopRequest = {
+  reason?: string;
+};
+
+/** Every HTTP error (400/401/403/404/405/409/413/429/500): what went wrong, why, what to do, and the request id that also appears in the server's log line.
+ * Schema: core/contracts/schemas/api_error.schema.json */
+export type ApiError = {
+  /** machine-readable code, e.g. invalid_body, unauthorized, not_found, rate_limited */
+  error: string;
+  cause: string;
+  suggestion: string;
+  /** ULID (Crockford base32, 26 characters) */
+  request_id: string;
+  /** JSON path of the offending field, when the body failed validation */
+  field?: string;
+};
+
+/** GET /api/v1/healthz (no token needed): ok when the database answers and the drone is connected; degraded otherwise.
+ * Schema: core/contracts/schemas/api_health.schema.json */
+export type Health = {
+  status: "ok" | "degraded";
+  version: string;
+  uptime_s: number;
+  db: {
+    ok: boolean;
+    path: string;
+    write_failures: number;
+  };
+  drone: WsStateData;
+};
+
+export const HEALTH_STATUS = ["ok","degraded"] as const;
+
+/** POST /api/v1/auth/login.
+ * Schema: core/contracts/schemas/api_login_request.schema.json */
+export type LoginRequest = {
+  /** the operator's e-mail address (the login name; compared case-insensitively) */
+  email: string;
+  password: string;
+};
+
+/** A bearer token (HS256 JWT) for REST (Authorization: Bearer ...) and /ws/live (?token=...). Valid until expires_at (at most 30 min) or logout.
+ * Schema: core/contracts/schemas/api_login_response.schema.json */
+export type LoginResponse = {
+  token: string;
+  token_type: "Bearer";
+  /** UTC, ISO 8601 with milliseconds and Z */
+  expires_at: string;
+  expires_in_s: number;
+  user: User;
+};
+
+/** POST /api/v1/auth/register. The password must have at least 10 characters and must not be (or contain) the e-mail address.
+ * Schema: core/contracts/schemas/api_register_request.schema.json */
+export type RegisterRequest = {
+  /** the operator's e-mail address (the login name; compared case-insensitively) */
+  email: string;
+  password: string;
+};
+
+/** POST /api/v1/sessions/{id}/replay (the body may be empty: speed 1).
+ * Schema: core/contracts/schemas/api_replay_request.schema.json */
+export type ReplayRequest = {
+  /** 1 = real time; 10 = ten times faster */
+  speed?: number;
+};
+
+/** 202: the replay streams to every /ws/live client, each message marked replay: true, ending with a state message whose data.replay.finished is true.
+ * Schema: core/contracts/schemas/api_replay_response.schema.json */
+export type ReplayStarted = {
+  /** ULID (Crockford base32, 26 characters) */
+  replay_id: string;
+  session_id: number;
+  speed: number;
+  messages: number;
+  /** at this speed */
+  duration_s: number;
+};
+
+/** GET /api/v1/sessions/{id}: the summary with every gesture, command and alert (telemetry: /telemetry).
+ * Schema: core/contracts/schemas/api_session_detail.schema.json */
+export type SessionDetail = {
+  session: SessionSummary;
+  gestures: GestureEvent[];
+  commands: CommandRecord[];
+  alerts: AlertRecord[];
+};
+
+/** GET /api/v1/sessions?limit=N&offset=M (newest first; limit 1..500, default 50).
+ * Schema: core/contracts/schemas/api_session_list.schema.json */
+export type SessionList = {
+  sessions: SessionSummary[];
+  total: number;
+  limit: number;
+  offset: number;
+};
+
+/** One control session (a drone connected to the server).
+ * Schema: core/contracts/schemas/api_session_summary.schema.json */
+export type SessionSummary = {
+  id: number;
+  user_id: null | number;
+  drone: string;
+  profile: string;
+  /** UTC, ISO 8601 with milliseconds and Z */
+  started_at: string;
+  ended_at: null | string;
+  open: boolean;
+  duration_s: number;
+  command_count: number;
+  alert_count: number;
+};
+
+/** GET /api/v1/sessions/{id}/telemetry?limit=N: frames oldest first (limit 1..100000, default all).
+ * Schema: core/contracts/schemas/api_telemetry_history.schema.json */
+export type TelemetryHistory = {
+  session_id: number;
+  count: number;
+  frames: TelemetryFrame[];
+};
+
+/** An operator account (never carries the password hash).
+ * Schema: core/contracts/schemas/api_user.schema.json */
+export type User = {
+  id: number;
+  /** the operator's e-mail address (the login name; compared case-insensitively) */
+  email: string;
+  theme: "light" | "dark";
+  /** UTC, ISO 8601 with milliseconds and Z */
+  created_at: string;
+};
+
+export const USER_THEME = ["light","dark"] as const;
+
 /** One command for the drone. MOVE carries a payload; the others carry none.
  * Schema: core/contracts/schemas/drone_command.schema.json */
 export type DroneCommand = {
@@ -125,9 +322,26 @@ export type VisionFrame = {
     gesture: "NONE" | "OPEN_PALM" | "FIST" | "THUMB_UP" | "THUMB_DOWN" | "POINT_LEFT" | "POINT_RIGHT" | "POINT_UP" | "VICTORY" | "I_LOVE_YOU";
     confidence: number;
   }>;
+  /** base64 JPEG of the frame, downscaled for the live feed; only with `gbdcs vision --publish-jpeg` */
+  jpeg?: string;
   /** the GestureEngine's event for this frame (onset or refresh), or null */
   gesture_event: null | GestureEvent;
 };
+
+/** One hand in a frame (the same shape as vision_frame's hands).
+ * Schema: core/contracts/schemas/vision_hand.schema.json */
+export type VisionHand = {
+  handedness: "Left" | "Right";
+  score: number;
+  /** 21 [x, y, z], x and y normalised to the frame */
+  landmarks: Array<number[]>;
+  gesture: "NONE" | "OPEN_PALM" | "FIST" | "THUMB_UP" | "THUMB_DOWN" | "POINT_LEFT" | "POINT_RIGHT" | "POINT_UP" | "VICTORY" | "I_LOVE_YOU";
+  confidence: number;
+};
+
+export const VISION_HAND_HANDEDNESS = ["Left","Right"] as const;
+
+export const VISION_HAND_GESTURE = ["NONE","OPEN_PALM","FIST","THUMB_UP","THUMB_DOWN","POINT_LEFT","POINT_RIGHT","POINT_UP","VICTORY","I_LOVE_YOU"] as const;
 
 /** Once a second from the vision worker (`gbdcs vision`): health, throughput, per-stage timing (p50/p95 over the last samples) and queue state. A supervisor that hears none for a while treats the worker as dead.
  * Schema: core/contracts/schemas/vision_heartbeat.schema.json */
@@ -179,4 +393,191 @@ export type VisionHeartbeat = {
       dropped: number;
     };
   };
+};
+
+/** Client -> server: acknowledge an alert (data.id of an alert message).
+ * Schema: core/contracts/schemas/ws_ack.schema.json */
+export type WsAck = {
+  type: "ack";
+  alert_id: number;
+};
+
+/** The answer to an ack: the alert is recorded as acknowledged.
+ * Schema: core/contracts/schemas/ws_ack_result_data.schema.json */
+export type WsAckResultData = {
+  alert_id: number;
+  /** UTC, ISO 8601 with milliseconds and Z */
+  acknowledged_at: string;
+};
+
+/** Confirms an ack.
+ * Schema: core/contracts/schemas/ws_ack_result_message.schema.json */
+export type WsAckResultMessage = {
+  type: "ack_result";
+  /** UTC, ISO 8601 with milliseconds and Z */
+  ts: string;
+  /** true when the message comes from a stored session being replayed */
+  replay?: boolean;
+  data: WsAckResultData;
+};
+
+/** A safety or health alert; data.id is what an ack names.
+ * Schema: core/contracts/schemas/ws_alert_message.schema.json */
+export type WsAlertMessage = {
+  type: "alert";
+  /** UTC, ISO 8601 with milliseconds and Z */
+  ts: string;
+  /** true when the message comes from a stored session being replayed */
+  replay?: boolean;
+  data: Alert;
+};
+
+/** Every message a client may send on /ws/live.
+ * Schema: core/contracts/schemas/ws_client_message.schema.json */
+export type WsClientMessage = WsAck | WsInput | WsEmergencyStop;
+
+/** A command and what happened to it.
+ * Schema: core/contracts/schemas/ws_command_data.schema.json */
+export type WsCommandData = {
+  command: DroneCommand;
+  /** OK, an adapter result, REFUSED: why, DROPPED: why */
+  outcome: string;
+};
+
+/** A command and its outcome.
+ * Schema: core/contracts/schemas/ws_command_message.schema.json */
+export type WsCommandMessage = {
+  type: "command";
+  /** UTC, ISO 8601 with milliseconds and Z */
+  ts: string;
+  /** true when the message comes from a stored session being replayed */
+  replay?: boolean;
+  data: WsCommandData;
+};
+
+/** Client -> server: stop the motors now (latches until POST /control/emergency-reset).
+ * Schema: core/contracts/schemas/ws_emergency_stop.schema.json */
+export type WsEmergencyStop = {
+  type: "emergency_stop";
+  reason?: string;
+};
+
+/** A client message the server refused, and why (the socket stays open).
+ * Schema: core/contracts/schemas/ws_error_data.schema.json */
+export type WsErrorData = {
+  error: string;
+  cause: string;
+  suggestion: string;
+  /** ULID (Crockford base32, 26 characters) */
+  request_id: string;
+};
+
+/** A client message that was refused.
+ * Schema: core/contracts/schemas/ws_error_message.schema.json */
+export type WsErrorMessage = {
+  type: "error";
+  /** UTC, ISO 8601 with milliseconds and Z */
+  ts: string;
+  /** true when the message comes from a stored session being replayed */
+  replay?: boolean;
+  data: WsErrorData;
+};
+
+/** One camera frame for the live feed: the downscaled JPEG (base64) when the worker sends pixels, and the hands found on it.
+ * Schema: core/contracts/schemas/ws_frame_data.schema.json */
+export type WsFrameData = {
+  frame_id: number;
+  /** UTC, ISO 8601 with milliseconds and Z */
+  capture_time: string;
+  width: number;
+  height: number;
+  latency_ms: number;
+  /** base64 JPEG (no data: prefix); absent for landmark-only sources */
+  jpeg?: string;
+  hands: VisionHand[];
+};
+
+/** A camera frame for the live feed (>= 24 FPS when the camera gives them).
+ * Schema: core/contracts/schemas/ws_frame_message.schema.json */
+export type WsFrameMessage = {
+  type: "frame";
+  /** UTC, ISO 8601 with milliseconds and Z */
+  ts: string;
+  /** true when the message comes from a stored session being replayed */
+  replay?: boolean;
+  data: WsFrameData;
+};
+
+/** A stabilised gesture (onset or refresh while held).
+ * Schema: core/contracts/schemas/ws_gesture_message.schema.json */
+export type WsGestureMessage = {
+  type: "gesture";
+  /** UTC, ISO 8601 with milliseconds and Z */
+  ts: string;
+  /** true when the message comes from a stored session being replayed */
+  replay?: boolean;
+  data: GestureEvent;
+};
+
+/** Client -> server: a key went down (pressed true) or up, for keyboard flying. Keys as KeyboardEvent.key: w a s d, arrows, q e (yaw), r f (up/down), t take off, l land, h hover, ' ' emergency stop.
+ * Schema: core/contracts/schemas/ws_input.schema.json */
+export type WsInput = {
+  type: "input";
+  key: string;
+  pressed: boolean;
+};
+
+/** Every message the server sends on /ws/live: {type, ts, replay?, data}.
+ * Schema: core/contracts/schemas/ws_server_message.schema.json */
+export type WsServerMessage = WsGestureMessage | WsTelemetryMessage | WsAlertMessage | WsCommandMessage | WsStateMessage | WsFrameMessage | WsAckResultMessage | WsErrorMessage;
+
+/** The server's view of the drone, the vision worker and replays: sent on connect and whenever it changes (at least every 2 s).
+ * Schema: core/contracts/schemas/ws_state_data.schema.json */
+export type WsStateData = {
+  adapter: string;
+  connected: boolean;
+  session_id: null | number;
+  flight_state: "INIT" | "READY" | "FLYING" | "LANDING" | "FAULT";
+  emergency_latched: boolean;
+  vision: {
+    /** take-off allowed as far as vision goes */
+    ready: boolean;
+    healthy: boolean;
+    reason: string;
+    fps: number;
+    source?: string;
+    worker_running: boolean;
+    worker_restarts: number;
+  };
+  clients: number;
+  replay?: null | {
+    /** ULID (Crockford base32, 26 characters) */
+    replay_id: string;
+    session_id: number;
+    finished: boolean;
+  };
+};
+
+export const WS_STATE_DATA_FLIGHT_STATE = ["INIT","READY","FLYING","LANDING","FAULT"] as const;
+
+/** The server's state (drone, vision worker, replay).
+ * Schema: core/contracts/schemas/ws_state_message.schema.json */
+export type WsStateMessage = {
+  type: "state";
+  /** UTC, ISO 8601 with milliseconds and Z */
+  ts: string;
+  /** true when the message comes from a stored session being replayed */
+  replay?: boolean;
+  data: WsStateData;
+};
+
+/** A telemetry frame of the connected drone (>= 5 Hz).
+ * Schema: core/contracts/schemas/ws_telemetry_message.schema.json */
+export type WsTelemetryMessage = {
+  type: "telemetry";
+  /** UTC, ISO 8601 with milliseconds and Z */
+  ts: string;
+  /** true when the message comes from a stored session being replayed */
+  replay?: boolean;
+  data: TelemetryFrame;
 };
