@@ -117,7 +117,10 @@ export function FlyPage({ live, frames, send, api, config, link, dispatch }: Pro
       <div className="fly-grid">
         <div className="fly-main">
           <Feed frames={frames} />
-          <GesturePanel live={live} config={config} />
+          <div className="fly-under">
+            <GesturePanel live={live} config={config} />
+            <PathMap path={live.path} />
+          </div>
         </div>
         <div className="fly-side">
           <section className="panel controls" aria-labelledby="controls-h">
@@ -194,7 +197,6 @@ export function FlyPage({ live, frames, send, api, config, link, dispatch }: Pro
           <ServerState live={live} />
         </div>
         <div className="fly-bottom">
-          <PathMap path={live.path} />
           <TwinView adapter={s?.adapter ?? null} />
           <CommandLog live={live} />
         </div>
