@@ -1,13 +1,13 @@
 #!/usr/bin/env bash
 # Renders the help page's gesture pictures from our hand model (sim/fixtures, OSMesa) with
-# `gbdcs fixture render --frame`: one small still per gesture into web/public/gestures/.
+# `gbdcs fixture render --frame`: one small still per gesture into web/src/assets/gestures/.
 # The PNGs are committed (the web build does not need the C++ build); rerun after a change to
 # the hand model:   web/scripts/render-gesture-pictures.sh [path/to/gbdcs]
 set -euo pipefail
 WEB="$(cd "$(dirname "$0")/.." && pwd)"
 ROOT="$(cd "$WEB/.." && pwd)"
 GBDCS="${1:-$ROOT/build/app/gbdcs}"
-OUT="$WEB/public/gestures"
+OUT="$WEB/src/assets/gestures"
 [[ -x "$GBDCS" ]] || { echo "render-gesture-pictures: $GBDCS not found; build it first (ci/build)" >&2; exit 1; }
 "$GBDCS" fixture render --help >/dev/null 2>&1 || {
   echo "render-gesture-pictures: this gbdcs has no 'fixture render' (the fixtures renderer is not built in)" >&2; exit 1; }
