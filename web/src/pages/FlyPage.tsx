@@ -32,7 +32,9 @@ export function FlyPage({ live, frames, send, api, config, link, dispatch }: Pro
     if (send({ type: 'emergency_stop', reason: 'operator: dashboard button or Space' })) return;
     try {
       await api.emergencyStop('operator: dashboard (socket down, sent over REST)');
+      setNotice('EMERGENCY STOP sent (over REST: the live connection is down)');
     } catch (e) {
+      setNotice('EMERGENCY STOP NOT DELIVERED: the server could not be reached.');
       if (e instanceof ApiFailure) setFailure(e);
     }
   };
