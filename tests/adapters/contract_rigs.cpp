@@ -2,8 +2,10 @@
 
 #include <nlohmann/json.hpp>
 
+#include "gbdcs/adapters/airsim_adapter.hpp"
 #include "gbdcs/adapters/dummy_adapter.hpp"
 #include "gbdcs/adapters/tello_adapter.hpp"
+#include "gbdcs/sim/airsim_emulator.hpp"
 #include "gbdcs/sim/tello_emulator.hpp"
 #include "gbdcs/sim/twin_adapter.hpp"
 #include "gbdcs/sim/twin_host.hpp"
@@ -104,6 +106,43 @@ class TelloRig final : public Rig {
 
 }  // namespace
 
+AirSimRig::AirSimRig(nlohmann::json extra)
+    : host_(clock, shared_model()), emulator_(host_, emulator_options()) {
+  nlohmann::json o = {{"address", "127.0.0.1"}, {"port", emulator_.port()},
+                      {"rpc_timeout_ms", 3000}, {"ack_wait_ms", 100},
+                      {"connect_timeout_ms", 5000}};
+  if (extra.is_object()) o.update(extra);
+  drone_ = std::make_unique<AirSimAdapter>(clock, AirSimOptions::from_json(o));
+  attach();
+}
+
+AirSimRig::~AirSimRig() = default;
+
+sim::AirSimEmulatorOptions AirSimRig::emulator_options() {
+  sim::AirSimEmulatorOptions e;
+  e.port = 0;
+  return e;
+}
+
+control::DroneAdapter& AirSimRig::adapter() { return *drone_; }
+void AirSimRig::set_link_lost(bool lost) { emulator_.set_link_lost(lost); }
+
+void AirSimRig::step(double dt_s) {
+  clock.advance(contracts::from_seconds(dt_s));
+  host_.poll();
+  drone_->poll();
+  settle();
+}
+
+void AirSimRig::settle() {
+  const bool ok = await([&] {
+    const auto a = drone_->stats();
+    const auto e = emulator_.stats();
+    return e.requests + e.malformed >= a.requests && a.responses >= e.responses;
+  });
+  EXPECT_TRUE(ok) << "the AirSim emulator and the adapter did not settle in 10 s";
+}
+
 std::unique_ptr<Rig> make_rig(const std::string& name) {
   if (name == "dummy") return std::make_unique<DummyRig>();
   if (name == "twin") return std::make_unique<TwinRig>();
@@ -112,12 +151,13 @@ std::unique_ptr<Rig> make_rig(const std::string& name) {
     emulator.command_port = 0;
     return std::make_unique<TelloRig>(nlohmann::json::object(), emulator, TelloOptions{});
   }
+  if (name == "airsim") return std::make_unique<AirSimRig>();
   throw std::invalid_argument("no rig named " + name);
 }
 
 std::vector<RigCase> all_rigs() {
   std::vector<RigCase> out;
-  for (const char* n : {"dummy", "twin", "tello"}) {
+  for (const char* n : {"dummy", "twin", "tello", "airsim"}) {
     out.push_back({n, [name = std::string(n)] { return make_rig(name); }});
   }
   return out;

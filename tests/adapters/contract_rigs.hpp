@@ -17,7 +17,11 @@
 
 #include "gbdcs/contracts/clock.hpp"
 #include "gbdcs/control/drone_adapter.hpp"
+#include "gbdcs/adapters/airsim_adapter.hpp"
+#include "gbdcs/sim/airsim_emulator.hpp"
+#include "gbdcs/sim/twin_host.hpp"
 #include "gbdcs/sim/twin_model.hpp"
+#include <nlohmann/json.hpp>
 
 namespace gbdcs::adapters::testing {
 
@@ -89,6 +93,28 @@ class Rig {
  private:
   mutable std::mutex mutex_;
   std::vector<contracts::TelemetryFrame> frames_;
+};
+
+// AirSimAdapter -> the twin's AirSim emulator over loopback TCP (exposed for AirSim's own tests).
+class AirSimRig final : public Rig {
+ public:
+  explicit AirSimRig(nlohmann::json extra_options = {});
+  ~AirSimRig() override;
+  control::DroneAdapter& adapter() override;
+  void set_link_lost(bool lost) override;
+  AirSimAdapter& airsim() { return *drone_; }
+  sim::AirSimEmulator& emulator() { return emulator_; }
+  sim::TwinHost& host() { return host_; }
+  void settle();
+
+ protected:
+  void step(double dt_s) override;
+
+ private:
+  static sim::AirSimEmulatorOptions emulator_options();
+  sim::TwinHost host_;
+  sim::AirSimEmulator emulator_;
+  std::unique_ptr<AirSimAdapter> drone_;
 };
 
 using RigFactory = std::function<std::unique_ptr<Rig>()>;
