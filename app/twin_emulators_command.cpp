@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "commands.hpp"
+#include "gbdcs/sim/airsim_emulator.hpp"
 #include "gbdcs/sim/tello_emulator.hpp"
 #include "gbdcs/sim/twin_host.hpp"
 #include "twin_emulators.hpp"
@@ -25,6 +26,9 @@ struct EmulatorCmdOptions {
   int tello_port = 8889;
   int tello_state_port = 8890;
   std::string tello_sdk = "2.0";
+  bool airsim = false;
+  int airsim_port = 41451;
+  std::string airsim_vehicle = "Drone1";
   std::string bind = "127.0.0.1";
   double duration_s = 0;
   unsigned seed = 1;
@@ -53,6 +57,14 @@ void add_twin_emulator_options(CLI::App* twin) {
   twin->add_option("--tello-sdk", o.tello_sdk, "Tello SDK the emulator speaks")
       ->capture_default_str()
       ->check(CLI::IsMember({"2.0", "1.3"}));
+  twin->add_flag("--airsim", o.airsim,
+                 "Serve the twin as an AirSim multirotor (msgpack-RPC over TCP) in real time");
+  twin->add_option("--airsim-port", o.airsim_port, "TCP port of the AirSim RPC (0: any)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 65535));
+  twin->add_option("--airsim-vehicle", o.airsim_vehicle,
+                   "Vehicle name the AirSim emulator answers to (besides \"\")")
+      ->capture_default_str();
   twin->add_option("--bind", o.bind,
                    "Address the emulators listen on (loopback by default; 0.0.0.0 to let "
                    "another machine fly the twin)")
@@ -66,7 +78,7 @@ void add_twin_emulator_options(CLI::App* twin) {
                    "the protocol traffic)");
 }
 
-bool twin_emulators_requested() { return g_options.tello; }
+bool twin_emulators_requested() { return g_options.tello || g_options.airsim; }
 
 int run_twin_emulators() {
   const auto& o = g_options;
@@ -88,6 +100,16 @@ int run_twin_emulators() {
               << tello->port() << " (state to the client's port " << o.tello_state_port
               << ")\n";
   }
+  std::optional<sim::AirSimEmulator> airsim;
+  if (o.airsim) {
+    sim::AirSimEmulatorOptions a;
+    a.bind_address = o.bind;
+    a.port = o.airsim_port;
+    a.vehicle = o.airsim_vehicle;
+    airsim.emplace(host, a);
+    std::cerr << "gbdcs twin: AirSim RPC on tcp://" << o.bind << ":" << airsim->port()
+              << " (vehicle \"" << o.airsim_vehicle << "\" or \"\")\n";
+  }
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   host.start();
@@ -107,6 +129,11 @@ int run_twin_emulators() {
         const auto st = tello->stats();
         std::cerr << "; tello " << st.datagrams << " datagrams, " << st.state_packets
                   << " states";
+      }
+      if (airsim) {
+        const auto st = airsim->stats();
+        std::cerr << "; airsim " << st.connections << " connections, " << st.requests
+                  << " requests";
       }
       std::cerr << "\n";
       std::cerr.unsetf(std::ios::fixed);

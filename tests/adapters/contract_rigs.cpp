@@ -138,7 +138,8 @@ void AirSimRig::settle() {
   const bool ok = await([&] {
     const auto a = drone_->stats();
     const auto e = emulator_.stats();
-    return e.requests + e.malformed >= a.requests && a.responses >= e.responses;
+    return e.requests + e.malformed + a.lost_requests >= a.requests &&
+           a.responses >= e.responses;
   });
   EXPECT_TRUE(ok) << "the AirSim emulator and the adapter did not settle in 10 s";
 }

@@ -143,7 +143,12 @@ TEST(TelloAdapter, EmulatorLandsBySelfAfterFifteenSilentSecondsAndTheAdapterSees
   const udp::endpoint to(asio::ip::make_address("127.0.0.1"), emulator.port());
   std::array<char, 512> buf{};
   udp::endpoint from;
-  auto send = [&](const std::string& cmd) { client.send_to(asio::buffer(cmd), to); };
+  std::uint64_t sent = 0;
+  auto send = [&](const std::string& cmd) {  // returns once the emulator has handled it
+    client.send_to(asio::buffer(cmd), to);
+    ++sent;
+    ASSERT_TRUE(await([&] { return emulator.stats().datagrams >= sent; }));
+  };
   auto reply = [&]() {
     std::string out = "<none>";
     await([&] {

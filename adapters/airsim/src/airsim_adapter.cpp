@@ -40,7 +40,8 @@ double wrap_deg(double deg) {
 struct AirSimAdapter::Impl {
   struct Call {
     std::string method;
-    bool done = false;
+    bool done = false;      // answered, expired or its connection lost
+    bool answered = false;  // ok/error/result hold the server's answer
     bool ok = false;
     std::string error;
     msgpack::object_handle result;
@@ -149,6 +150,7 @@ struct AirSimAdapter::Impl {
     boost::system::error_code ignored;
     socket.close(ignored);
     last_error = why + " (reconnecting)";
+    stats.lost_requests += calls.size();
     for (auto& [id, c] : calls) {
       c->done = true;
       c->error = "connection lost";
@@ -206,6 +208,7 @@ struct AirSimAdapter::Impl {
     auto call = it->second;
     calls.erase(it);
     call->done = true;
+    call->answered = true;
     call->ok = response->ok;
     call->error = response->error;
     call->result = std::move(response->result);
@@ -302,7 +305,7 @@ struct AirSimAdapter::Impl {
     calls[id] = c;
     boost::system::error_code ec;
     asio::write(socket, asio::buffer(bytes), ec);
-    ++stats.requests;
+    if (!ec) ++stats.requests;
     if (ec) {
       calls.erase(id);
       lost_socket_locked("cannot send to AirSim at " + where() + ": " + ec.message());
@@ -351,6 +354,11 @@ struct AirSimAdapter::Impl {
       last_error = what + ": no answer from AirSim at " + where() + " in " +
                    std::to_string(options.rpc_timeout_ms) + " ms";
       return Result::kTimeout;
+    }
+    if (!c->answered) {
+      last_error = what + ": " + (c->error.empty() ? "no answer from AirSim" : c->error) +
+                   " (AirSim at " + where() + ")";
+      return c->error.empty() ? Result::kTimeout : Result::kNotConnected;
     }
     if (!c->ok) {
       last_error = what + ": AirSim answered: " + c->error;

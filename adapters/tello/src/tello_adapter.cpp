@@ -60,7 +60,8 @@ bool is_error_reply(const std::string& reply) {
 struct TelloAdapter::Impl {
   struct Pending {
     std::string command;
-    bool done = false;
+    bool done = false;      // answered, expired or abandoned: nobody waits any more
+    bool answered = false;  // `reply` holds the drone's answer
     bool deferred = false;  // the caller stopped waiting (take-off/land): outcome logged only
     std::string reply;
     WallClock::time_point expires;
@@ -157,6 +158,7 @@ struct TelloAdapter::Impl {
     auto p = pending.front();
     pending.pop_front();
     p->reply = text;
+    p->answered = true;
     p->done = true;
     if (p->deferred && is_error_reply(text)) {
       last_error = p->command + ": the " + options.drone_label + " answered '" + text +
@@ -312,7 +314,8 @@ struct TelloAdapter::Impl {
       return std::nullopt;
     }
     reply_cv.wait_for(lock, wait, [&] { return p->done; });
-    if (p->done) return p->reply;
+    if (p->answered) return p->reply;
+    if (p->done) return std::nullopt;  // expired or abandoned (an emergency cleared it)
     if (deferred) {
       p->deferred = true;
       p->expires = WallClock::now() + std::chrono::duration_cast<WallClock::duration>(

@@ -255,6 +255,7 @@ struct AirSimEmulator::Impl : std::enable_shared_from_this<AirSimEmulator::Impl>
   void close(const std::shared_ptr<Session>& s) {
     if (s->closed) return;
     s->closed = true;
+    if (!s->writing) discarded += s->queue.size();
     boost::system::error_code ignored;
     s->socket.close(ignored);
     std::lock_guard lock(mutex);
@@ -313,6 +314,7 @@ struct AirSimEmulator::Impl : std::enable_shared_from_this<AirSimEmulator::Impl>
                       [this, s](boost::system::error_code ec, std::size_t) {
                         s->queue.pop_front();
                         if (ec) {
+                          discarded += s->queue.size() + 1;
                           close(s);
                           return;
                         }
@@ -338,7 +340,12 @@ struct AirSimEmulator::Impl : std::enable_shared_from_this<AirSimEmulator::Impl>
     }
     ++responses;  // atomic: callers may hold `mutex`
     asio::post(io, [this, weak, bytes = std::string(buffer.data(), buffer.size())]() mutable {
-      if (auto s = weak.lock()) write(s, std::move(bytes));
+      auto s = weak.lock();
+      if (!s || s->closed) {
+        ++discarded;  // its client is gone
+        return;
+      }
+      write(s, std::move(bytes));
     });
   }
 
@@ -577,6 +584,7 @@ struct AirSimEmulator::Impl : std::enable_shared_from_this<AirSimEmulator::Impl>
   std::optional<Task> task;
   AirSimEmulatorStats stats;
   std::atomic<std::uint64_t> responses{0};
+  std::atomic<std::uint64_t> discarded{0};  // responses whose client was gone
 };
 
 AirSimEmulator::AirSimEmulator(TwinHost& host, AirSimEmulatorOptions options)
@@ -608,7 +616,7 @@ void AirSimEmulator::drop_connections() {
 AirSimEmulatorStats AirSimEmulator::stats() const {
   std::lock_guard lock(impl_->mutex);
   auto s = impl_->stats;
-  s.responses = impl_->responses;
+  s.responses = impl_->responses - impl_->discarded;
   return s;
 }
 

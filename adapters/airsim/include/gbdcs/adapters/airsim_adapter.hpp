@@ -68,6 +68,7 @@ struct AirSimStats {
   std::uint64_t connects = 0;   // successful TCP connections (first + reconnects)
   std::uint64_t link_losses = 0;
   std::uint64_t outstanding = 0;  // requests waiting for their response
+  std::uint64_t lost_requests = 0;  // unanswered when a connection broke
 };
 
 class AirSimAdapter final : public control::DroneAdapter {

@@ -48,7 +48,7 @@ struct AirSimEmulatorStats {
   std::uint64_t connections = 0;
   std::uint64_t requests = 0;  // every request frame received, answered or dropped
   std::uint64_t dropped = 0;   // during a link loss
-  std::uint64_t responses = 0;
+  std::uint64_t responses = 0;  // sent, or on their way, to a connected client
   std::uint64_t malformed = 0;
   std::string last_malformed;
 };
