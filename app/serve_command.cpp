@@ -142,6 +142,7 @@ int run_serve(ServeOptions o) {
 
   std::unique_ptr<server::WorkerSupervisor> supervisor;
   std::atomic<double> fps{0};
+  std::atomic<bool> pipeline_healthy{true};
   if (!o.no_worker) {
     server::WorkerOptions wo;
     wo.argv = {std::filesystem::read_symlink("/proc/self/exe").string(), "vision", "--source",
@@ -170,7 +171,11 @@ int run_serve(ServeOptions o) {
            supervisor->on_message();
            if (msg["type"] == "heartbeat") {
              fps = msg.value("fps", 0.0);
-             if (!msg.value("healthy", true)) drone.on_vision_health(false, msg.value("reason", ""));
+             // The pipeline's own verdict, passed on when it changes (both ways).
+             const bool healthy = msg.value("healthy", true);
+             if (healthy != pipeline_healthy.exchange(healthy)) {
+               drone.on_vision_health(healthy, healthy ? "" : msg.value("reason", ""));
+             }
              return;
            }
            http.metrics().vision_frames++;

@@ -64,6 +64,7 @@ struct ApiContext {
   LoginLimiter& limiter;
   const ServerOptions& options;
   EventLog log;
+  contracts::Duration started{};  // clock time the server was made (uptime)
 };
 
 // The authenticated caller, or throws ApiError 401.

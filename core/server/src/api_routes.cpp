@@ -309,7 +309,6 @@ ApiResponse do_ereset(ApiContext& ctx) {
 }
 
 ApiResponse do_health(ApiContext& ctx) {
-  static const auto started = ctx.clock.now();
   bool db_ok = true;
   try {
     ctx.storage.session_count();
@@ -320,7 +319,7 @@ ApiResponse do_health(ApiContext& ctx) {
   const bool good = db_ok && drone.value("connected", false);
   return ok({{"status", good ? "ok" : "degraded"},
              {"version", ctx.options.version},
-             {"uptime_s", contracts::to_seconds(ctx.clock.now() - started)},
+             {"uptime_s", contracts::to_seconds(ctx.clock.now() - ctx.started)},
              {"db", {{"ok", db_ok}, {"path", ctx.storage.path()},
                      {"write_failures", ctx.storage.write_failures()}}},
              {"drone", drone}});

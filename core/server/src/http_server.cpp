@@ -28,7 +28,7 @@ struct Server::Impl {
        LiveHub& h, ServerOptions o, EventLog l)
       : clock(c), storage(s), tokens(t), drone(d), hub(h), options(std::move(o)), log(std::move(l)),
         limiter(c), replays(c, s, h, d), ids(c),
-        ctx{c, s, t, d, h, metrics, replays, limiter, options, log}, acceptor(ioc) {}
+        ctx{c, s, t, d, h, metrics, replays, limiter, options, log, c.now()}, acceptor(ioc) {}
 
   const contracts::Clock& clock;
   storage::StorageManager& storage;
