@@ -168,7 +168,8 @@ CriterionResult failsafe(const Criterion& c, const RunRecord& r) {
   out.expected = c.alert + (c.severity ? " (" + std::string(contracts::to_string(*c.severity)) + ")"
                                        : std::string()) +
                  (c.action ? " + " + std::string(contracts::to_string(*c.action)) : "") + " " +
-                 band(c, "<=", " ms") + " after " + num(c.from_s, 2) + " s";
+                 band(c, "<=", " ms") + " after " + num(c.from_s, 2) + " s" +
+                 (c.not_before_ms > 0 ? " (not before " + num(c.not_before_ms) + " ms)" : "");
   const RecordedAlert* alert = nullptr;
   for (const auto& a : r.alerts) {
     if (a.alert.code == c.alert && a.t_s >= c.from_s - 1e-9 &&
@@ -186,6 +187,10 @@ CriterionResult failsafe(const Criterion& c, const RunRecord& r) {
   }
   double done_s = alert->t_s;
   out.actual = c.alert + " at +" + num((alert->t_s - c.from_s) * 1000) + " ms";
+  if ((alert->t_s - c.from_s) * 1000.0 < c.not_before_ms) {
+    out.actual += ", too early (before " + num(c.not_before_ms) + " ms)";
+    return out;
+  }
   if (c.action) {
     const RecordedCommand* action = nullptr;
     for (const auto& cmd : r.commands) {

@@ -396,6 +396,10 @@ Criterion read_criterion(const nlohmann::json& v, const std::string& origin,
         if (!c.severity) g.fail("severity", "use INFO, WARNING or CRITICAL");
       }
       thresholds(g, c, "within_ms", "acceptable_ms", 0, 3.6e6, false);
+      c.not_before_ms = g.opt_number("not_before_ms", 0, 3.6e6).value_or(0);
+      if (c.not_before_ms > c.success) {
+        g.fail("not_before_ms", "must be at most within_ms (the window is [not_before_ms, within_ms])");
+      }
       const bool has_from = g.has("from_s");
       const bool has_event = g.has("from_event");
       if (has_from && has_event) g.fail("from_s", "give from_s or from_event, not both");

@@ -132,6 +132,7 @@ struct Criterion {
   std::optional<contracts::CommandType> action;  // failsafe; nullopt = "none"
   std::optional<contracts::Severity> severity;   // failsafe
   double from_s = 0;                             // failsafe: the fault's time
+  double not_before_ms = 0;  // failsafe: earlier than this after from_s is a FAILURE (too eager)
   std::vector<std::string> alerts_contain;       // alerts
   std::vector<std::string> alerts_never;
   std::vector<CommandPattern> contains;  // command_sequence
