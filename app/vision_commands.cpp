@@ -19,6 +19,7 @@
 #include "gbdcs/vision/model_files.hpp"
 #include "gbdcs/vision/vision_messages.hpp"
 #include "gbdcs/vision/vision_pipeline.hpp"
+#include "source_factory.hpp"
 #include "vision_support.hpp"
 
 namespace gbdcs::app {
@@ -72,7 +73,7 @@ int run_vision(const VisionOptions& o) {
   std::unique_ptr<vision::CaptureSource> source;
   std::unique_ptr<vision::HandFinder> finder;
   try {
-    source = vision::open_source(o.source, clock);
+    source = open_any_source(o.source, clock);
     // A folder holds unrelated stills: detect in each (MediaPipe's static image mode).
     const bool stills = o.source.rfind("images:", 0) == 0;
     finder = vision::make_tracker_finder(tracker_options(o.models, stills), clock);
@@ -180,6 +181,17 @@ int run_recognize(const RecognizeOptions& o) {
   };
   for (const auto& file : o.files) {
     try {
+      if (is_source_spec(file)) {  // camera:N, video:PATH, images:DIR, recipe:PATH
+        auto source = open_any_source(file, clock);
+        const bool still_frames = file.rfind("images:", 0) == 0;
+        auto finder = vision::make_tracker_finder(tracker_options(o.models, still_frames), clock);
+        while (auto frame = source->next()) {
+          cv::Mat bgr = frame->rgb;
+          if (frame->order == vision::PixelOrder::kRgb) cv::cvtColor(frame->rgb, bgr, cv::COLOR_RGB2BGR);
+          out(recognize_frame(*finder, classifier, bgr, file, frame->frame_id), true);
+        }
+        continue;
+      }
       if (std::error_code ec; !std::filesystem::is_regular_file(file, ec)) {
         throw std::runtime_error("no such file (check the path)");
       }
@@ -275,7 +287,7 @@ void add_vision_commands(CLI::App& app) {
       "vision",
       "Run the vision pipeline (capture -> landmarks -> gesture) on a camera, video or image "
       "folder; prints JSON lines: a frame message per frame, a heartbeat every second");
-  vision_cmd->add_option("--source", v.source, "camera:N, video:PATH or images:DIR")->required();
+  vision_cmd->add_option("--source", v.source, "camera:N, video:PATH, images:DIR or recipe:PATH[?live=1]")->required();
   add_model_options(vision_cmd, v.models);
   vision_cmd->add_option("--publish", v.publish,
                          "WebSocket URL to publish to (not available until the server lands)");
@@ -292,7 +304,7 @@ void add_vision_commands(CLI::App& app) {
       "recognize",
       "Find hands in images (each on its own) or videos (tracked frame to frame): 21 "
       "landmarks, handedness, presence and the recognised gesture");
-  recognize->add_option("FILES", r.files, "Images (.jpg .png ...) or videos")->required();
+  recognize->add_option("FILES", r.files, "Images (.jpg .png ...), videos, or source specs (video:PATH, images:DIR, recipe:PATH, camera:N)")->required();
   recognize->add_flag("--json", r.json, "One JSON array, an object per image or video frame");
   add_model_options(recognize, r.models);
   recognize->callback([] { guarded("recognize", [] { return run_recognize(r); }); });

@@ -1,0 +1,27 @@
+#include "source_factory.hpp"
+
+#include <array>
+#include <string>
+
+namespace gbdcs::app {
+
+bool is_source_spec(std::string_view spec) {
+  constexpr std::array<std::string_view, 4> kSchemes = {"camera:", "video:", "images:",
+                                                        "recipe:"};
+  for (auto scheme : kSchemes) {
+    if (spec.substr(0, scheme.size()) == scheme) return true;
+  }
+  return false;
+}
+
+std::unique_ptr<vision::CaptureSource> open_any_source(std::string_view spec,
+                                                       const contracts::Clock& clock) {
+  if (spec.substr(0, 7) == "recipe:") {
+    throw vision::CaptureError(std::string(spec) +
+                               ": recipe sources are not built into this gbdcs yet; render the "
+                               "recipe with `gbdcs fixture render` and use video:PATH");
+  }
+  return vision::open_source(spec, clock);
+}
+
+}  // namespace gbdcs::app

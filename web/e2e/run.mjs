@@ -1,0 +1,315 @@
+#!/usr/bin/env node
+// End-to-end test of the dashboard in a real browser against a real `gbdcs serve`.
+//
+//   node e2e/run.mjs --gbdcs build/app/gbdcs [--out build/web-e2e] [--chromium /usr/bin/chromium]
+//                    [--fps-seconds 60] [--keep]
+//
+// Starts `gbdcs serve` on a free loopback port with a temporary SQLite database (twin drone,
+// the default rendered-hand camera), drives Debian's chromium headless through playwright-core
+// (no browser download), and walks an operator's flight: a bad login shows the server's cause
+// and suggestion; register and log in; telemetry and the gesture update; the drone takes off
+// by gesture; an alert appears (the vision worker is killed) and is acknowledged; the
+// emergency stop (Space) brings it down; a stored session is replayed; log out. A screenshot
+// of each step goes to --out. With --fps-seconds N it also measures the feed's frame rate
+// over N seconds and writes it to --out/feed_fps.json.
+//
+// Fails (exit 1) when chromium, the gbdcs binary or its `serve` command is missing: never skips.
+/* global document, window, localStorage -- functions passed to page.evaluate run in the page */
+import { spawn, execFileSync } from 'node:child_process';
+import { existsSync, mkdirSync, mkdtempSync, rmSync, writeFileSync } from 'node:fs';
+import { createServer } from 'node:net';
+import { tmpdir } from 'node:os';
+import { join, resolve, dirname } from 'node:path';
+import { fileURLToPath } from 'node:url';
+
+const here = dirname(fileURLToPath(import.meta.url));
+const repo = resolve(here, '..', '..');
+
+function arg(name, fallback) {
+  const i = process.argv.indexOf(`--${name}`);
+  return i >= 0 ? process.argv[i + 1] : fallback;
+}
+const gbdcs = resolve(arg('gbdcs', process.env.GBDCS_BIN ?? join(repo, 'build', 'app', 'gbdcs')));
+const out = resolve(arg('out', join(repo, 'build', 'web-e2e')));
+const chromiumPath = arg('chromium', process.env.GBDCS_CHROMIUM ?? '/usr/bin/chromium');
+const fpsSeconds = Number(arg('fps-seconds', '0'));
+const keep = process.argv.includes('--keep');
+// Generous: a loaded 2-core CI machine renders the hand video and runs the models.
+const STEP_MS = Number(process.env.GBDCS_E2E_STEP_MS ?? 90_000);
+
+function fail(msg) {
+  console.error(`web e2e: FAIL: ${msg}`);
+  process.exitCode = 1;
+  throw new Error(msg);
+}
+
+const log = (m) => console.log(`web e2e: ${m}`);
+
+async function freePort() {
+  return new Promise((res, rej) => {
+    const s = createServer();
+    s.once('error', rej);
+    s.listen(0, '127.0.0.1', () => {
+      const { port } = s.address();
+      s.close(() => res(port));
+    });
+  });
+}
+
+async function waitHttp(url, ms, child) {
+  const end = Date.now() + ms;
+  let last = '';
+  while (Date.now() < end) {
+    if (child.exitCode !== null) fail(`gbdcs serve exited with ${child.exitCode} before answering`);
+    try {
+      const r = await fetch(url);
+      if (r.ok) return await r.json();
+      last = `HTTP ${r.status}`;
+    } catch (e) {
+      last = e.message;
+    }
+    await new Promise((r) => setTimeout(r, 250));
+  }
+  fail(`${url} did not answer within ${ms} ms (${last})`);
+}
+
+async function main() {
+  if (!existsSync(chromiumPath))
+    fail(`chromium not found at ${chromiumPath} (ci/setup installs Debian's chromium)`);
+  if (!existsSync(gbdcs)) fail(`gbdcs binary not found at ${gbdcs} (build it: ci/build)`);
+  try {
+    execFileSync(gbdcs, ['serve', '--help'], { stdio: 'pipe' });
+  } catch (e) {
+    fail(
+      `\`${gbdcs} serve --help\` failed: the server (issue 7) is not built into this binary (${e.message.split('\n')[0]})`,
+    );
+  }
+  if (!existsSync(join(repo, 'web', 'dist', 'index.html')))
+    fail('web/dist is not built (ci/setup builds it)');
+  let chromium;
+  try {
+    ({ chromium } = await import('playwright-core'));
+  } catch {
+    fail('playwright-core is not installed (cd web && npm ci)');
+  }
+
+  mkdirSync(out, { recursive: true });
+  const tmp = mkdtempSync(join(tmpdir(), 'gbdcs-web-e2e-'));
+  const port = await freePort();
+  const base = `http://127.0.0.1:${port}`;
+  const serverLog = join(out, 'serve.log');
+  const logFd = [];
+  const child = spawn(
+    gbdcs,
+    [
+      'serve',
+      '--port',
+      String(port),
+      '--bind',
+      '127.0.0.1',
+      '--db',
+      join(tmp, 'gbdcs.db'),
+      '--adapter',
+      'twin',
+    ],
+    {
+      cwd: repo,
+      env: { ...process.env, GBDCS_TOKEN_TTL_S: '1800' },
+      stdio: ['ignore', 'pipe', 'pipe'],
+    },
+  );
+  child.stdout.on('data', (d) => logFd.push(d));
+  child.stderr.on('data', (d) => logFd.push(d));
+  let browser;
+  const shots = [];
+  try {
+    log(`gbdcs serve on ${base} (db in ${tmp})`);
+    await waitHttp(`${base}/api/v1/healthz`, 120_000, child);
+
+    browser = await chromium.launch({
+      executablePath: chromiumPath,
+      headless: true,
+      args: [
+        '--no-sandbox',
+        '--disable-dev-shm-usage',
+        '--autoplay-policy=no-user-gesture-required',
+      ],
+    });
+    const page = await browser.newPage({ viewport: { width: 1366, height: 900 } });
+    const errors = [];
+    page.on('pageerror', (e) => errors.push(e.message));
+    let n = 0;
+    const shot = async (name) => {
+      const file = join(out, `${String(++n).padStart(2, '0')}-${name}.png`);
+      await page.screenshot({ path: file });
+      shots.push(file);
+      log(`step ${n}: ${name} ok (${file})`);
+    };
+    const text = (testid) => page.getByTestId(testid).innerText();
+    const waitText = async (testid, pred, what) => {
+      try {
+        await page.waitForFunction(
+          ([id, src]) => {
+            const el = document.querySelector(`[data-testid="${id}"]`);
+            return !!el && new Function('t', `return (${src})(t)`)(el.textContent ?? '');
+          },
+          [testid, pred.toString()],
+          { timeout: STEP_MS },
+        );
+      } catch {
+        const now = await page
+          .getByTestId(testid)
+          .innerText()
+          .catch(() => '(absent)');
+        fail(`${what}: [${testid}] is "${now}"`);
+      }
+    };
+
+    // 1. A bad login shows the server's own cause and suggestion.
+    await page.goto(base + '/');
+    const email = `pilot-${Date.now()}@example.com`;
+    const password = 'correct horse battery';
+    const bad = await fetch(`${base}/api/v1/auth/login`, {
+      method: 'POST',
+      headers: { 'Content-Type': 'application/json' },
+      body: JSON.stringify({ email, password: 'wrong password 123' }),
+    }).then((r) => r.json());
+    await page.getByLabel('E-mail').fill(email);
+    await page.getByLabel('Password').fill('wrong password 123');
+    await page.getByRole('button', { name: 'Log in', exact: true }).last().click();
+    const box = page.getByRole('alert').filter({ hasText: 'Could not log in' });
+    await box.waitFor({ timeout: STEP_MS });
+    const boxText = await box.innerText();
+    if (!boxText.includes(bad.cause) || !boxText.includes(bad.suggestion))
+      fail(
+        `bad login: the page shows "${boxText}", not the server's cause "${bad.cause}" and suggestion "${bad.suggestion}"`,
+      );
+    await shot('bad-login-shows-cause-and-suggestion');
+
+    // 2. Register and log in.
+    await page.getByRole('tab', { name: 'Register' }).click();
+    await page.getByLabel('Password').fill(password);
+    await page.getByRole('button', { name: 'Create account' }).click();
+    await page.getByRole('navigation', { name: 'Main' }).waitFor({ timeout: STEP_MS });
+    await shot('registered-and-logged-in');
+
+    // 3. Telemetry flows and the gesture updates.
+    await waitText('altitude', (t) => /m$/.test(t), 'telemetry never arrived');
+    await waitText('link', (t) => t === 'OK' || t === 'DEGRADED', 'link not OK');
+    await waitText('gesture', (t) => t !== 'No gesture', 'no gesture recognised from the camera');
+    const firstGesture = await text('gesture');
+    await waitText(
+      'gesture',
+      new Function(`return (t) => t !== ${JSON.stringify(firstGesture)}`)(),
+      'the gesture never changed',
+    );
+    await waitText('feed-fps', (t) => parseFloat(t) > 0, 'the feed shows no frames');
+    await shot('telemetry-and-gesture-live');
+
+    // 4. The drone takes off by gesture (the demo hand shows the take-off gesture).
+    await waitText('flight-state', (t) => t === 'FLYING', 'the drone never took off');
+    const log1 = await page.locator('.command-log').innerText();
+    if (!/TAKEOFF[\s\S]*gesture/.test(log1))
+      fail(`took off, but not by gesture: command log is "${log1}"`);
+    await waitText('path-map', () => true, 'no path map');
+    await shot('took-off-by-gesture');
+
+    // 5. An alert appears and is acknowledged: kill -9 the vision worker (the server's child).
+    const kids = execFileSync('ps', ['-o', 'pid=,args=', '--ppid', String(child.pid)]).toString();
+    const worker = kids
+      .split('\n')
+      .map((l) => l.trim())
+      .find((l) => /\bvision\b/.test(l));
+    if (!worker) fail(`no vision worker among gbdcs serve's children:\n${kids}`);
+    process.kill(Number(worker.split(/\s+/)[0]), 'SIGKILL');
+    const banner = page
+      .locator(
+        '[data-testid="alert"][data-code="VISION_WORKER_LOST"], [data-testid="alert"].alert-critical',
+      )
+      .first();
+    await banner.waitFor({ timeout: STEP_MS });
+    const alertText = await banner.innerText();
+    await shot('alert-shown');
+    await banner.getByRole('button', { name: 'Acknowledge' }).click();
+    await banner.waitFor({ state: 'detached', timeout: STEP_MS });
+    const acked = await fetch(`${base}/api/v1/sessions?limit=1`, {
+      headers: {
+        Authorization: `Bearer ${await page.evaluate(() => JSON.parse(localStorage.getItem('gbdcs.login')).token)}`,
+      },
+    }).then((r) => r.json());
+    log(`alert "${alertText.split('\n')[0]}" acknowledged; session ${acked.sessions[0]?.id}`);
+    await shot('alert-acknowledged');
+
+    // The worker restarts; fly again if the hover left it airborne, else wait for take-off.
+    await waitText('vision', (t) => t.startsWith('healthy'), 'the vision worker did not come back');
+    await waitText('flight-state', (t) => t === 'FLYING', 'not flying before the emergency stop');
+
+    // 6. Emergency stop (Space) brings it down.
+    await page.locator('body').press('Space');
+    await waitText('flight-state', (t) => t !== 'FLYING', 'still FLYING after the emergency stop');
+    await page.getByText('Emergency stop is latched').waitFor({ timeout: STEP_MS });
+    await waitText(
+      'altitude',
+      (t) => parseFloat(t) < 0.2,
+      'the drone is not down after the emergency stop',
+    );
+    await shot('emergency-stop-landed');
+    await page.getByRole('button', { name: 'Release emergency stop' }).click();
+
+    if (fpsSeconds > 0) {
+      await page.evaluate(() => (window.__gbdcsFeed.drawn = 0));
+      const t0 = Date.now();
+      const received0 = await page.evaluate(() => window.__gbdcs.frames.received);
+      await page.waitForTimeout(fpsSeconds * 1000);
+      const r = await page.evaluate(() => ({
+        drawn: window.__gbdcsFeed.drawn,
+        received: window.__gbdcs.frames.received,
+      }));
+      const s = (Date.now() - t0) / 1000;
+      const result = {
+        window_s: Number(s.toFixed(1)),
+        feed_fps_drawn: Number((r.drawn / s).toFixed(2)),
+        feed_fps_received: Number(((r.received - received0) / s).toFixed(2)),
+      };
+      writeFileSync(join(out, 'feed_fps.json'), JSON.stringify(result, null, 2) + '\n');
+      log(
+        `feed over ${result.window_s} s: ${result.feed_fps_drawn} FPS drawn, ${result.feed_fps_received} FPS received`,
+      );
+    }
+
+    // 7. Replay a stored session.
+    await page.getByRole('link', { name: 'Sessions' }).click();
+    await page.getByTestId('sessions').waitFor({ timeout: STEP_MS });
+    await shot('sessions-list');
+    await page
+      .getByRole('link', { name: /Replay session/ })
+      .first()
+      .click();
+    await page.getByTestId('replay-play').waitFor({ timeout: STEP_MS });
+    await page.getByTestId('replay-speed').selectOption('16');
+    await page.getByTestId('replay-play').click();
+    await waitText('altitude', (t) => /m$/.test(t), 'the replay shows no telemetry');
+    await waitText('replay-clock', (t) => !t.startsWith('0:00 '), 'the replay clock does not move');
+    await waitText('gesture', (t) => t !== 'No gesture', 'the replay shows no gesture');
+    await shot('replay-playing');
+
+    // 8. Log out: the socket closes, back to the login screen.
+    await page.getByRole('button', { name: 'Log out' }).click();
+    await page.getByText('You logged out.').waitFor({ timeout: STEP_MS });
+    await shot('logged-out');
+
+    if (errors.length) fail(`errors in the page: ${errors.join('; ')}`);
+    log(`PASS (${shots.length} screenshots in ${out})`);
+  } finally {
+    await browser?.close().catch(() => {});
+    child.kill('SIGTERM');
+    await new Promise((r) => (child.exitCode !== null ? r() : child.once('exit', r)));
+    writeFileSync(serverLog, Buffer.concat(logFd));
+    if (!keep) rmSync(tmp, { recursive: true, force: true });
+  }
+}
+
+main().catch((e) => {
+  if (!process.exitCode) console.error(`web e2e: FAIL: ${e.stack ?? e}`);
+  process.exitCode = 1;
+});
