@@ -3,6 +3,8 @@
 #include <array>
 #include <string>
 
+#include "fixture_support.hpp"
+
 namespace gbdcs::app {
 
 bool is_source_spec(std::string_view spec) {
@@ -16,11 +18,7 @@ bool is_source_spec(std::string_view spec) {
 
 std::unique_ptr<vision::CaptureSource> open_any_source(std::string_view spec,
                                                        const contracts::Clock& clock) {
-  if (spec.substr(0, 7) == "recipe:") {
-    throw vision::CaptureError(std::string(spec) +
-                               ": recipe sources are not built into this gbdcs yet; render the "
-                               "recipe with `gbdcs fixture render` and use video:PATH");
-  }
+  if (spec.substr(0, 7) == "recipe:") return open_recipe_source(spec, clock);
   return vision::open_source(spec, clock);
 }
 

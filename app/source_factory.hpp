@@ -2,7 +2,8 @@
 //
 //   camera:N, video:PATH, images:DIR   -> vision::open_source (core/vision)
 //   recipe:PATH[?live=1]               -> a fixture recipe rendered on the fly through the
-//                                         MuJoCo hand model (sim/fixtures), when available
+//                                         MuJoCo hand model (sim/fixtures, OSMesa); live=1
+//                                         loops it at its frame rate like a camera
 //
 // Throws vision::CaptureError naming the source and the fix when it cannot be opened.
 #pragma once

@@ -119,6 +119,33 @@ std::array<Point3, lm::kLandmarkCount> hand_points_mm(const HandPose& pose) {
   return out;
 }
 
+HandJointAngles joint_angles(const HandPose& pose) {
+  HandJointAngles out;
+  for (std::size_t f = 0; f < kFingerCount; ++f) {
+    const double flex_gain = std::max(0.0, std::cos(detail::deg_to_rad(pose.fingers[f].mcp_deg)));
+    out.finger_abduction_deg[f] = kFingers[f].base_angle_deg + kFingers[f].spread_gain *
+                                                                   pose.spread_deg *
+                                                                   (0.3 + 0.7 * flex_gain);
+  }
+  const ThumbPose& thumb = pose.thumb;
+  const double alpha = detail::deg_to_rad(kThumbBaseAngleDeg + thumb.cmc_abduction_deg);
+  const double beta = detail::deg_to_rad(thumb.cmc_flexion_deg);
+  const Vec3 palm_normal{0, 0, 1};
+  const Vec3 in_plane{std::sin(alpha), std::cos(alpha), 0};
+  const Vec3 metacarpal = std::cos(beta) * in_plane + std::sin(beta) * palm_normal;
+  const Vec3 across{-std::cos(alpha), std::sin(alpha), 0};
+  const double gamma = detail::deg_to_rad(20 + 0.4 * thumb.cmc_flexion_deg);
+  Vec3 curl = std::cos(gamma) * across + std::sin(gamma) * palm_normal;
+  curl = detail::normalized(curl - dot(curl, metacarpal) * metacarpal);
+  // The metacarpal's frame after the two base rotations: x is the flexion axis.
+  const Vec3 x1{std::cos(alpha), -std::sin(alpha), 0};
+  const Vec3 z1 = cross(x1, metacarpal);
+  out.thumb_abduction_deg = kThumbBaseAngleDeg + thumb.cmc_abduction_deg;
+  out.thumb_flexion_deg = thumb.cmc_flexion_deg;
+  out.thumb_twist_deg = detail::rad_to_deg(std::atan2(dot(curl, x1), dot(curl, z1)));
+  return out;
+}
+
 contracts::Landmarks synthesize(const HandPose& pose, const Placement& placement) {
   check_placement(placement);
   const HandOrientation& o = pose.orientation;

@@ -2,7 +2,22 @@ import { HAND_CONNECTIONS } from '../logic/skeleton';
 import { POSES, poseLandmarks } from '../logic/handPose';
 import type { MappableGesture } from '../types';
 
+// Renders of our hand model (web/scripts/render-gesture-pictures.sh), when present.
+const RENDERED = import.meta.glob('../assets/gestures/*.png', {
+  eager: true,
+  query: '?url',
+  import: 'default',
+}) as Record<string, string>;
+
+export function renderedPicture(gesture: MappableGesture): string | undefined {
+  return RENDERED[`../assets/gestures/${gesture}.png`];
+}
+
+export const HAVE_RENDERED_PICTURES = Object.keys(RENDERED).length > 0;
+
 export function HandPicture({ gesture, label }: { gesture: MappableGesture; label: string }) {
+  const src = renderedPicture(gesture);
+  if (src) return <img src={src} alt={label} className="hand-picture" width={240} height={180} />;
   const pts = poseLandmarks(POSES[gesture]).map(([x, y]) => [x * 100, y * 100] as const);
   return (
     <svg viewBox="0 0 100 100" className="hand-picture" role="img" aria-label={label}>

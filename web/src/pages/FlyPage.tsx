@@ -32,7 +32,9 @@ export function FlyPage({ live, frames, send, api, config, link, dispatch }: Pro
     if (send({ type: 'emergency_stop', reason: 'operator: dashboard button or Space' })) return;
     try {
       await api.emergencyStop('operator: dashboard (socket down, sent over REST)');
+      setNotice('EMERGENCY STOP sent (over REST: the live connection is down)');
     } catch (e) {
+      setNotice('EMERGENCY STOP NOT DELIVERED: the server could not be reached.');
       if (e instanceof ApiFailure) setFailure(e);
     }
   };
@@ -117,7 +119,10 @@ export function FlyPage({ live, frames, send, api, config, link, dispatch }: Pro
       <div className="fly-grid">
         <div className="fly-main">
           <Feed frames={frames} />
-          <GesturePanel live={live} config={config} />
+          <div className="fly-under">
+            <GesturePanel live={live} config={config} />
+            <PathMap path={live.path} />
+          </div>
         </div>
         <div className="fly-side">
           <section className="panel controls" aria-labelledby="controls-h">
@@ -194,7 +199,6 @@ export function FlyPage({ live, frames, send, api, config, link, dispatch }: Pro
           <ServerState live={live} />
         </div>
         <div className="fly-bottom">
-          <PathMap path={live.path} />
           <TwinView adapter={s?.adapter ?? null} />
           <CommandLog live={live} />
         </div>

@@ -1,4 +1,4 @@
-import { HandPicture } from '../components/HandPicture';
+import { HAVE_RENDERED_PICTURES, HandPicture } from '../components/HandPicture';
 import { gestureLabel, mappingText } from '../components/Panels';
 import { ALERT_HELP, ERROR_HELP } from '../logic/alerts';
 import { KEY_BINDINGS } from '../logic/keys';
@@ -31,10 +31,12 @@ export function HelpPage({ config }: { config: Config | null }) {
           {config ? `Profile in force: “${config.profile.name}”.` : 'Loading the profile…'} Change
           the mapping in Settings.
         </p>
-        <p className="muted">
-          The pictures are schematic skeletons drawn here; pictures rendered from the hand model
-          replace them when the fixtures renderer can export them.
-        </p>
+        {!HAVE_RENDERED_PICTURES && (
+          <p className="muted">
+            These pictures are schematic skeletons: the renders of our hand model are made by
+            web/scripts/render-gesture-pictures.sh once the fixtures renderer is built in.
+          </p>
+        )}
         <ul className="gesture-cards">
           {MAPPABLE_GESTURES.map((g) => (
             <li key={g} className="panel">

@@ -1,5 +1,5 @@
 // Replay of a stored session with the flying view's panels: play, pause, speed and a timeline
-// scrubber (keyboard: Space/K play-pause, arrows seek 5 s, Home/End).
+// scrubber (keyboard: Space/K play-pause; on the scrubber, arrows seek 1 s, Home/End).
 import { useEffect, useRef, useState } from 'react';
 import { Api, ApiFailure } from '../api/http';
 import { ErrorBox } from '../components/ErrorBox';
@@ -141,7 +141,7 @@ export function ReplayPage({
           className="scrubber"
           min={0}
           max={Math.max(1, total)}
-          step={100}
+          step={1000}
           value={player.positionMs}
           onChange={(e) => seekTo(Number(e.target.value))}
           aria-label="Position in the session"

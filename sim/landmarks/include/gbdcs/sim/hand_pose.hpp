@@ -87,6 +87,21 @@ struct Placement {
 // not applied. For renderers that need the skeleton itself.
 std::array<contracts::Point3, contracts::kLandmarkCount> hand_points_mm(const HandPose& pose);
 
+// The same pose as the joint angles of an articulated hand (sim/models/hand.xml) built on the
+// knuckle positions and bone lengths of hand_points_mm(): per finger the in-plane abduction
+// (+ toward the thumb) then MCP/PIP/DIP flexion; the thumb's metacarpal turned in the palm
+// plane by thumb_abduction_deg (+ toward the thumb side, from the palm's y axis), tilted
+// toward the palm by thumb_flexion_deg, then twisted about itself by thumb_twist_deg (right-
+// handed about the metacarpal) so that its MCP and IP joints bend in the plane they bend in
+// hand_points_mm(). Degrees. Placing hinges this way reproduces hand_points_mm() exactly.
+struct HandJointAngles {
+  std::array<double, kFingerCount> finger_abduction_deg{};
+  double thumb_abduction_deg = 0;
+  double thumb_flexion_deg = 0;
+  double thumb_twist_deg = 0;
+};
+HandJointAngles joint_angles(const HandPose& pose);
+
 // Throws std::invalid_argument for a Placement outside its stated ranges (size <= 0,
 // |yaw| or |pitch| > 40, aspect_ratio <= 0, presence outside [0, 1], non-finite values).
 contracts::Landmarks synthesize(const HandPose& pose, const Placement& placement);

@@ -1,0 +1,557 @@
+// `gbdcs eval FIXTURE_DIR... | RECIPE.json... | --manifest CSV`: how well the tracker and the
+// rule-based recogniser do on fixtures (rendered with ground truth, or recorded) and on a
+// folder of labelled photos. `eval landmarks` is in vision_commands.cpp.
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <map>
+#include <opencv2/core/utils/logger.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <sstream>
+
+#include "command_registry.hpp"
+#include "commands.hpp"
+#include "fixture_support.hpp"
+#include "gbdcs/contracts/codec.hpp"
+#include "gbdcs/vision/model_files.hpp"
+#include "gbdcs/vision/vision_pipeline.hpp"
+#include "vision_support.hpp"
+
+namespace gbdcs::app {
+namespace {
+
+namespace fs = std::filesystem;
+using contracts::GestureType;
+using nlohmann::json;
+
+constexpr std::size_t kClasses = contracts::kAllGestures.size();
+
+std::size_t class_index(GestureType g) {
+  for (std::size_t i = 0; i < kClasses; ++i)
+    if (contracts::kAllGestures[i] == g) return i;
+  return 0;
+}
+
+struct Tally {
+  std::int64_t visible_frames = 0;   // hand fully visible (rendered) or expected (photos)
+  std::int64_t detected_frames = 0;  // ... where the tracker found it
+  std::int64_t deliberate_scored = 0;
+  std::int64_t deliberate_correct = 0;
+  std::int64_t non_deliberate_scored = 0;
+  std::int64_t false_positives = 0;
+  double landmark_error_sum_pct = 0;
+  std::int64_t landmark_error_count = 0;
+  double landmark_error_max_pct = 0;
+  std::array<double, contracts::kLandmarkCount> point_error_sum_pct{};
+  std::array<std::array<std::int64_t, kClasses>, kClasses> confusion{};  // [true][predicted]
+
+  void add(const Tally& o) {
+    visible_frames += o.visible_frames;
+    detected_frames += o.detected_frames;
+    deliberate_scored += o.deliberate_scored;
+    deliberate_correct += o.deliberate_correct;
+    non_deliberate_scored += o.non_deliberate_scored;
+    false_positives += o.false_positives;
+    landmark_error_sum_pct += o.landmark_error_sum_pct;
+    landmark_error_count += o.landmark_error_count;
+    landmark_error_max_pct = std::max(landmark_error_max_pct, o.landmark_error_max_pct);
+    for (std::size_t i = 0; i < contracts::kLandmarkCount; ++i)
+      point_error_sum_pct[i] += o.point_error_sum_pct[i];
+    for (std::size_t t = 0; t < kClasses; ++t)
+      for (std::size_t p = 0; p < kClasses; ++p) confusion[t][p] += o.confusion[t][p];
+  }
+  void score(GestureType truth, GestureType predicted, bool deliberate) {
+    confusion[class_index(truth)][class_index(predicted)]++;
+    if (deliberate) {
+      ++deliberate_scored;
+      if (predicted == truth) ++deliberate_correct;
+    } else {
+      ++non_deliberate_scored;
+      if (predicted != GestureType::kNone) ++false_positives;
+    }
+  }
+  std::int64_t scored() const { return deliberate_scored + non_deliberate_scored; }
+  std::int64_t correct() const {
+    std::int64_t c = 0;
+    for (std::size_t i = 0; i < kClasses; ++i) c += confusion[i][i];
+    return c;
+  }
+};
+
+std::optional<double> ratio(std::int64_t a, std::int64_t b) {
+  if (b == 0) return std::nullopt;
+  return static_cast<double>(a) / static_cast<double>(b);
+}
+
+json opt(const std::optional<double>& v) { return v ? json(*v) : json(nullptr); }
+
+json summary_json(const Tally& t) {
+  json per_class = json::object();
+  for (std::size_t c = 0; c < kClasses; ++c) {
+    std::int64_t tp = t.confusion[c][c], predicted = 0, actual = 0;
+    for (std::size_t o = 0; o < kClasses; ++o) {
+      predicted += t.confusion[o][c];
+      actual += t.confusion[c][o];
+    }
+    if (predicted == 0 && actual == 0) continue;
+    per_class[std::string(contracts::to_string(contracts::kAllGestures[c]))] = {
+        {"precision", opt(ratio(tp, predicted))},
+        {"recall", opt(ratio(tp, actual))},
+        {"support_frames", actual},
+        {"predicted_frames", predicted}};
+  }
+  json labels = json::array();
+  json matrix = json::array();
+  for (std::size_t c = 0; c < kClasses; ++c) {
+    labels.push_back(contracts::to_string(contracts::kAllGestures[c]));
+    matrix.push_back(t.confusion[c]);
+  }
+  json by_point = json::array();
+  for (double v : t.point_error_sum_pct)
+    by_point.push_back(t.landmark_error_count > 0
+                           ? json(v / static_cast<double>(t.landmark_error_count))
+                           : json(nullptr));
+  return {{"accuracy", opt(ratio(t.correct(), t.scored()))},
+          {"landmark_error_pct_by_point", by_point},
+          {"deliberate_accuracy", opt(ratio(t.deliberate_correct, t.deliberate_scored))},
+          {"false_positive_rate", opt(ratio(t.false_positives, t.non_deliberate_scored))},
+          {"detection_rate", opt(ratio(t.detected_frames, t.visible_frames))},
+          {"landmark_error_pct_mean",
+           t.landmark_error_count > 0
+               ? json(t.landmark_error_sum_pct / static_cast<double>(t.landmark_error_count))
+               : json(nullptr)},
+          {"landmark_error_pct_max",
+           t.landmark_error_count > 0 ? json(t.landmark_error_max_pct) : json(nullptr)},
+          {"frames_scored", t.scored()},
+          {"deliberate_frames", t.deliberate_scored},
+          {"non_deliberate_frames", t.non_deliberate_scored},
+          {"false_positive_frames", t.false_positives},
+          {"visible_frames", t.visible_frames},
+          {"detected_frames", t.detected_frames},
+          {"per_class", per_class},
+          {"confusion", {{"labels", labels}, {"matrix", matrix}}}};
+}
+
+json read_json(const fs::path& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(path.string() + ": cannot read (check the path)");
+  std::stringstream s;
+  s << in.rdbuf();
+  return contracts::parse_json(s.str());
+}
+
+// Mean distance between two hands in pixels.
+double mean_distance_px(const contracts::Landmarks& a, const json& truth, int w, int h) {
+  double sum = 0;
+  for (std::size_t i = 0; i < contracts::kLandmarkCount; ++i) {
+    const double dx = (a.points[i].x - truth[i][0].get<double>()) * w;
+    const double dy = (a.points[i].y - truth[i][1].get<double>()) * h;
+    sum += std::hypot(dx, dy);
+  }
+  return sum / contracts::kLandmarkCount;
+}
+
+struct EvalOptions {
+  std::vector<std::string> inputs;
+  std::string manifest;
+  std::string cache_dir;
+  bool json = false;
+  bool check = false;
+  bool per_fixture = false;
+  double min_detection = 0.98;
+  double max_landmark_error_pct = 3.0;
+  double min_accuracy = 0.97;
+  double max_false_positive_rate = 0.005;
+  ModelChoice models;
+};
+
+// One fixture folder: video.mp4 + labels.json.
+Tally eval_fixture(const fs::path& dir, vision::HandFinder& finder,
+                   vision::HandClassifier& classifier, const contracts::Clock& clock) {
+  const json labels = read_json(dir / "labels.json");
+  if (!labels.contains("frames") || !labels["frames"].is_array())
+    throw std::runtime_error((dir / "labels.json").string() +
+                             ": no \"frames\" array (check it with `gbdcs fixture check`)");
+  const auto& frames = labels["frames"];
+  auto source = vision::open_video(dir / "video.mp4", clock);
+  finder.reset();
+  Tally t;
+  std::size_t i = 0;
+  while (auto frame = source->next()) {
+    if (i >= frames.size()) break;
+    const json& l = frames[i++];
+    cv::Mat rgb;
+    cv::cvtColor(frame->rgb, rgb, frame->order == vision::PixelOrder::kBgr ? cv::COLOR_BGR2RGB
+                                                                             : cv::COLOR_RGB2BGR);
+    if (frame->order == vision::PixelOrder::kRgb) rgb = frame->rgb;
+    classifier.set_frame_size(rgb.cols, rgb.rows);
+    const auto hands = classifier.classify(finder.find(rgb));
+    const bool deliberate = l.value("deliberate", false);
+    const bool transition = l.value("in_transition", false);
+    const bool fully_visible = l.value("fully_visible", false);
+    const auto truth = contracts::gesture_from_string(l.value("gesture", "NONE"))
+                           .value_or(GestureType::kNone);
+    const json& gt = l.contains("landmarks") ? l["landmarks"] : json(nullptr);
+    // Which detected hand is the labelled one: the nearest to the ground truth, within half
+    // the hand's size; without landmarks (recorded fixtures), the most present hand.
+    const vision::HandResult* match = nullptr;
+    double match_px = 0;
+    if (gt.is_array() && gt.size() == contracts::kLandmarkCount) {
+      const double size = l.value("hand_size_px", 0.0);
+      for (const auto& h : hands) {
+        const double d = mean_distance_px(h.landmarks, gt, rgb.cols, rgb.rows);
+        if ((match == nullptr || d < match_px) && d < 0.5 * size) {
+          match = &h;
+          match_px = d;
+        }
+      }
+      if (fully_visible) {
+        ++t.visible_frames;
+        if (match != nullptr) {
+          ++t.detected_frames;
+          const double pct = 100.0 * match_px / std::max(1.0, size);
+          t.landmark_error_sum_pct += pct;
+          ++t.landmark_error_count;
+          t.landmark_error_max_pct = std::max(t.landmark_error_max_pct, pct);
+          for (std::size_t k = 0; k < contracts::kLandmarkCount; ++k) {
+            t.point_error_sum_pct[k] +=
+                100.0 *
+                std::hypot((match->landmarks.points[k].x - gt[k][0].get<double>()) * rgb.cols,
+                           (match->landmarks.points[k].y - gt[k][1].get<double>()) * rgb.rows) /
+                std::max(1.0, size);
+          }
+        }
+      }
+    } else if (l.value("hand_present", false) && !hands.empty()) {
+      match = &hands.front();
+    }
+    if (transition) continue;
+    GestureType predicted = match != nullptr ? match->gesture : GestureType::kNone;
+    if (deliberate) {
+      // A gesture is judged where it can be seen whole.
+      if (!fully_visible && gt.is_array()) continue;
+    } else {
+      // Any gesture from any hand on a frame without a deliberate gesture is a false positive.
+      for (const auto& h : hands)
+        if (h.gesture != GestureType::kNone) predicted = h.gesture;
+    }
+    t.score(deliberate ? truth : GestureType::kNone, predicted, deliberate);
+  }
+  return t;
+}
+
+std::optional<GestureType> mediapipe_to_ours(std::string name) {
+  static const std::map<std::string, GestureType> kMap = {
+      {"Closed_Fist", GestureType::kFist},     {"Open_Palm", GestureType::kOpenPalm},
+      {"Pointing_Up", GestureType::kPointUp},  {"Thumb_Up", GestureType::kThumbUp},
+      {"Thumb_Down", GestureType::kThumbDown}, {"Victory", GestureType::kVictory},
+      {"ILoveYou", GestureType::kILoveYou},    {"None", GestureType::kNone},
+      {"NO_HAND", GestureType::kNone}};
+  if (auto it = kMap.find(name); it != kMap.end()) return it->second;
+  if (auto ours = contracts::gesture_from_string(name)) return *ours;
+  // Annotated labels: "NO_GESTURE (people, ...)" and a bare comment "(2 hands, ...)" mean no
+  // gesture; otherwise the first word decides ("Victory (left hand)").
+  if (name.rfind("NO_GESTURE", 0) == 0 || name.rfind("(", 0) == 0) return GestureType::kNone;
+  if (const auto cut = name.find_first_of(" ("); cut != std::string::npos && cut > 0)
+    return mediapipe_to_ours(name.substr(0, cut));
+  return std::nullopt;
+}
+
+std::vector<std::string> split_csv_line(const std::string& line) {
+  std::vector<std::string> out;
+  std::string cell;
+  bool quoted = false;
+  for (std::size_t i = 0; i < line.size(); ++i) {
+    const char c = line[i];
+    if (quoted) {
+      if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
+        cell += '"';
+        ++i;
+      } else if (c == '"') {
+        quoted = false;
+      } else {
+        cell += c;
+      }
+    } else if (c == '"') {
+      quoted = true;
+    } else if (c == ',') {
+      out.push_back(cell);
+      cell.clear();
+    } else if (c != '\r') {
+      cell += c;
+    }
+  }
+  out.push_back(cell);
+  return out;
+}
+
+Tally eval_manifest(const fs::path& csv, vision::HandFinder& finder,
+                    vision::HandClassifier& classifier, json& rows_out) {
+  std::ifstream in(csv);
+  if (!in) throw std::runtime_error(csv.string() + ": cannot read (check the path)");
+  std::string line;
+  if (!std::getline(in, line)) throw std::runtime_error(csv.string() + ": empty manifest");
+  const auto header = split_csv_line(line);
+  const auto col = [&](const std::string& name) -> std::size_t {
+    const auto it = std::find(header.begin(), header.end(), name);
+    if (it == header.end())
+      throw std::runtime_error(csv.string() + ": no \"" + name +
+                               "\" column; the header must name path and "
+                               "expected_mediapipe_gesture");
+    return static_cast<std::size_t>(it - header.begin());
+  };
+  const std::size_t path_col = col("path");
+  const std::size_t gesture_col = col("expected_mediapipe_gesture");
+  Tally t;
+  int row = 1;
+  while (std::getline(in, line)) {
+    ++row;
+    if (line.empty()) continue;
+    const auto cells = split_csv_line(line);
+    if (cells.size() <= std::max(path_col, gesture_col))
+      throw std::runtime_error(csv.string() + ": row " + std::to_string(row) + " has too few cells");
+    const auto expected = mediapipe_to_ours(cells[gesture_col]);
+    if (!expected)
+      throw std::runtime_error(csv.string() + ": row " + std::to_string(row) + ": unknown gesture \"" +
+                               cells[gesture_col] + "\" (MediaPipe's names or ours)");
+    fs::path image = cells[path_col];
+    if (image.is_relative()) image = csv.parent_path() / image;
+    cv::Mat bgr = cv::imread(image.string(), cv::IMREAD_COLOR);
+    if (bgr.empty())
+      throw std::runtime_error(image.string() + ": cannot decode (row " + std::to_string(row) + ")");
+    cv::Mat rgb;
+    cv::cvtColor(bgr, rgb, cv::COLOR_BGR2RGB);
+    classifier.set_frame_size(rgb.cols, rgb.rows);
+    const auto hands = classifier.classify(finder.find(rgb));
+    // A hand is expected unless the row says there is none (or only incidental ones).
+    const bool hand_expected =
+        cells[gesture_col] != "NO_HAND" && cells[gesture_col].rfind("NO_GESTURE", 0) != 0;
+    if (hand_expected) {
+      ++t.visible_frames;
+      if (!hands.empty()) ++t.detected_frames;
+    }
+    GestureType predicted = GestureType::kNone;
+    for (const auto& h : hands) {
+      if (h.gesture != GestureType::kNone) {
+        predicted = h.gesture;
+        break;
+      }
+    }
+    const bool deliberate = *expected != GestureType::kNone;
+    t.score(*expected, predicted, deliberate);
+    rows_out.push_back({{"path", cells[path_col]},
+                        {"expected", contracts::to_string(*expected)},
+                        {"predicted", contracts::to_string(predicted)},
+                        {"hands", hands.size()}});
+  }
+  return t;
+}
+
+std::string fmt_pct(const json& v) {
+  if (v.is_null()) return "-";
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(2) << 100 * v.get<double>() << " %";
+  return s.str();
+}
+
+void print_summary(const std::string& title, const json& s) {
+  std::cout << title << "\n"
+            << "  detection rate      " << fmt_pct(s["detection_rate"]) << " ("
+            << s["detected_frames"] << " of " << s["visible_frames"] << " fully visible)\n"
+            << "  landmark error      ";
+  if (s["landmark_error_pct_mean"].is_null()) {
+    std::cout << "- (no ground truth)\n";
+  } else {
+    std::cout << std::fixed << std::setprecision(2) << s["landmark_error_pct_mean"].get<double>()
+              << " % of hand size mean, " << s["landmark_error_pct_max"].get<double>()
+              << " % worst\n";
+  }
+  std::cout << "  accuracy            " << fmt_pct(s["accuracy"]) << " of " << s["frames_scored"]
+            << " frames\n"
+            << "  deliberate accuracy " << fmt_pct(s["deliberate_accuracy"]) << " of "
+            << s["deliberate_frames"] << "\n"
+            << "  false positives     " << fmt_pct(s["false_positive_rate"]) << " ("
+            << s["false_positive_frames"] << " of " << s["non_deliberate_frames"]
+            << " non-deliberate)\n";
+}
+
+void print_classes(const json& s) {
+  std::cout << "\n  " << std::left << std::setw(12) << "class" << std::right << std::setw(11)
+            << "precision" << std::setw(10) << "recall" << std::setw(9) << "frames\n";
+  for (const auto& [name, c] : s["per_class"].items()) {
+    std::cout << "  " << std::left << std::setw(12) << name << std::right << std::setw(11)
+              << fmt_pct(c["precision"]) << std::setw(10) << fmt_pct(c["recall"]) << std::setw(8)
+              << c["support_frames"] << "\n";
+  }
+  std::cout << "\n  confusion (rows: truth, columns: predicted)\n  " << std::setw(12) << "";
+  const auto& labels = s["confusion"]["labels"];
+  const auto& matrix = s["confusion"]["matrix"];
+  for (const auto& l : labels) std::cout << std::setw(6) << l.get<std::string>().substr(0, 5);
+  std::cout << "\n";
+  for (std::size_t r = 0; r < labels.size(); ++r) {
+    std::int64_t row_total = 0;
+    for (const auto& v : matrix[r]) row_total += v.get<std::int64_t>();
+    if (row_total == 0) continue;
+    std::cout << "  " << std::left << std::setw(12) << labels[r].get<std::string>() << std::right;
+    for (const auto& v : matrix[r]) std::cout << std::setw(6) << v.get<std::int64_t>();
+    std::cout << "\n";
+  }
+}
+
+int run_eval(const EvalOptions& o) {
+  cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_ERROR);
+  if (o.inputs.empty() && o.manifest.empty()) {
+    std::cerr << "gbdcs eval: give fixture folders, recipes, or --manifest CSV "
+                 "(see gbdcs eval --help)\n";
+    return 2;
+  }
+  contracts::SteadyClock clock;
+  vision::HandClassifier classifier;
+  Tally total;
+  json sources = json::array();
+  // Resolve the inputs: fixture folders, recipes (rendered into the cache), folders of
+  // recipes.
+  std::vector<fs::path> fixtures;
+  std::vector<fs::path> recipes;
+  for (const auto& in : o.inputs) {
+    const fs::path p(in);
+    if (fs::is_directory(p) && fs::exists(p / "labels.json")) {
+      fixtures.push_back(p);
+    } else if (fs::is_directory(p)) {
+      std::vector<fs::path> found;
+      for (const auto& e : fs::directory_iterator(p))
+        if (e.path().extension() == ".json" && e.path().filename() != "recipe.schema.json")
+          found.push_back(e.path());
+      std::sort(found.begin(), found.end());
+      if (found.empty())
+        throw std::runtime_error(in + ": neither a fixture (no labels.json) nor a folder of recipes");
+      recipes.insert(recipes.end(), found.begin(), found.end());
+    } else if (p.extension() == ".json" && fs::is_regular_file(p)) {
+      recipes.push_back(p);
+    } else {
+      throw std::runtime_error(in + ": not a fixture folder, a recipe or a folder of recipes "
+                                    "(check the path)");
+    }
+  }
+  if (!recipes.empty()) {
+    const fs::path cache = o.cache_dir.empty() ? fs::temp_directory_path() / "gbdcs-fixture-cache"
+                                               : fs::path(o.cache_dir);
+    for (const auto& r : recipes) {
+      fixtures.push_back(cached_fixture(r, cache, terminal_progress("render " + r.stem().string())));
+    }
+  }
+  if (!fixtures.empty()) {
+    auto finder = vision::make_tracker_finder(tracker_options(o.models, false), clock);
+    for (const auto& dir : fixtures) {
+      const Tally t = eval_fixture(dir, *finder, classifier, clock);
+      total.add(t);
+      json s = summary_json(t);
+      s["fixture"] = dir.string();
+      if (!o.json && o.per_fixture) print_summary(dir.string(), s);
+      sources.push_back(s);
+    }
+  }
+  json rows = json::array();
+  if (!o.manifest.empty()) {
+    auto finder = vision::make_tracker_finder(tracker_options(o.models, true), clock);
+    const Tally t = eval_manifest(o.manifest, *finder, classifier, rows);
+    total.add(t);
+    json s = summary_json(t);
+    s["manifest"] = o.manifest;
+    sources.push_back(s);
+  }
+  json doc = summary_json(total);
+  bool pass = true;
+  json failures = json::array();
+  if (o.check) {
+    auto need = [&](const char* key, bool ok, const std::string& what) {
+      if (!ok) {
+        pass = false;
+        failures.push_back(std::string(key) + ": " + what);
+      }
+    };
+    const auto& d = doc;
+    need("detection_rate", !d["detection_rate"].is_null() && d["detection_rate"] >= o.min_detection,
+         "below " + std::to_string(o.min_detection));
+    if (!d["landmark_error_pct_mean"].is_null())
+      need("landmark_error_pct_mean", d["landmark_error_pct_mean"] <= o.max_landmark_error_pct,
+           "above " + std::to_string(o.max_landmark_error_pct) + " %");
+    need("deliberate_accuracy",
+         !d["deliberate_accuracy"].is_null() && d["deliberate_accuracy"] >= o.min_accuracy,
+         "below " + std::to_string(o.min_accuracy));
+    if (!d["false_positive_rate"].is_null())
+      need("false_positive_rate", d["false_positive_rate"] <= o.max_false_positive_rate,
+           "above " + std::to_string(o.max_false_positive_rate));
+    doc["pass"] = pass;
+    doc["failures"] = failures;
+  }
+  doc["sources"] = sources;
+  if (!rows.empty()) doc["manifest_rows"] = rows;
+  if (o.json) {
+    std::cout << doc.dump(1) << "\n";
+  } else {
+    print_summary("overall (" + std::to_string(sources.size()) + " sources)", doc);
+    print_classes(doc);
+    if (o.check) {
+      for (const auto& f : failures) std::cout << "  MISSED " << f.get<std::string>() << "\n";
+      std::cout << (pass ? "PASS" : "FAIL") << "\n";
+    }
+  }
+  return pass ? 0 : 1;
+}
+
+void add_eval_command(CLI::App& app) {
+  static EvalOptions o;
+  auto* eval = group_command(app, "eval", "Compare results against a reference");
+  eval->require_subcommand(0, 1);
+  eval->description(
+      "Measure the tracker and the recogniser on fixtures (folders with video.mp4 + "
+      "labels.json, recipes rendered on demand, folders of recipes) and/or a manifest of "
+      "labelled photos: detection rate, landmark error, per-class precision/recall, "
+      "confusion matrix, accuracy, false-positive rate. `eval landmarks` compares two "
+      "recognize outputs");
+  eval->add_option("INPUTS", o.inputs, "Fixture folders, recipe .json files or folders of recipes");
+  eval->add_option("--manifest", o.manifest,
+                   "CSV with columns path, expected_mediapipe_gesture (MediaPipe's names: "
+                   "Closed_Fist, Open_Palm, ..., None, NO_HAND; paths relative to the CSV)");
+  eval->add_option("--cache", o.cache_dir,
+                   "Where recipes are rendered, keyed by recipe hash (default: "
+                   "$TMPDIR/gbdcs-fixture-cache)");
+  eval->add_flag("--json", o.json, "One JSON object");
+  eval->add_flag("--per-fixture", o.per_fixture, "Also print each fixture's figures");
+  eval->add_flag("--check", o.check,
+                 "Exit 1 unless the targets are met (docs/ACCURACY.md): detection, landmark "
+                 "error, deliberate accuracy, false positives");
+  eval->add_option("--min-detection", o.min_detection, "Target: detection rate (fraction)")
+      ->capture_default_str();
+  eval->add_option("--max-landmark-error-pct", o.max_landmark_error_pct,
+                   "Target: mean landmark error, % of the hand's bounding-box diagonal")
+      ->capture_default_str();
+  eval->add_option("--min-accuracy", o.min_accuracy,
+                   "Target: accuracy on deliberate frames (fraction)")
+      ->capture_default_str();
+  eval->add_option("--max-fp-rate", o.max_false_positive_rate,
+                   "Target: false positives on non-deliberate frames (fraction)")
+      ->capture_default_str();
+  add_model_options(eval, o.models);
+  eval->callback([eval] {
+    if (!eval->get_subcommands().empty()) return;  // `eval landmarks` ran
+    try {
+      g_exit_code = run_eval(o);
+    } catch (const std::exception& e) {
+      std::cerr << "gbdcs eval: " << e.what() << "\n";
+      g_exit_code = 2;
+    }
+  });
+}
+
+const CommandRegistration kEval{45, &add_eval_command};
+
+}  // namespace
+}  // namespace gbdcs::app

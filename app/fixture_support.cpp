@@ -1,0 +1,144 @@
+#include "fixture_support.hpp"
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <thread>
+
+#include "gbdcs/sim/fixture_renderer.hpp"
+#include "gbdcs/sim/hand_scene.hpp"
+#include "gbdcs/sim/recipe.hpp"
+#include "gbdcs/sim/video_recorder.hpp"
+
+namespace gbdcs::app {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Bump when the renderer's output changes for the same recipe (invalidates caches).
+constexpr std::string_view kRendererVersion = "fixture-renderer/1";
+
+std::uint64_t fnv1a(std::string_view text, std::uint64_t h = 1469598103934665603ULL) {
+  for (unsigned char c : text) {
+    h ^= c;
+    h *= 1099511628211ULL;
+  }
+  return h;
+}
+
+std::string read_text(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+}  // namespace
+
+void render_fixture(const fs::path& recipe_path, const fs::path& out_dir,
+                    const Progress& progress) {
+  sim::Recipe recipe = sim::load_recipe(recipe_path);
+  std::error_code ec;
+  fs::create_directories(out_dir, ec);
+  if (ec) throw std::runtime_error(out_dir.string() + ": cannot create the folder: " + ec.message());
+  sim::FixtureRenderer renderer(recipe);
+  const fs::path video_tmp = out_dir / "video.partial.mp4";
+  std::vector<sim::FrameLabel> labels;
+  {
+    sim::VideoRecorderOptions vo;
+    vo.fps = recipe.fps;
+    sim::VideoRecorder video(video_tmp, cv::Size(recipe.width, recipe.height), vo);
+    const auto n = renderer.frame_count();
+    for (std::int64_t i = 0; i < n; ++i) {
+      auto frame = renderer.frame(i);
+      video.write(frame.bgr);
+      labels.push_back(std::move(frame.label));
+      if (progress) progress(i + 1, n);
+    }
+    video.close();
+  }
+  const fs::path labels_tmp = out_dir / "labels.partial.json";
+  {
+    std::ofstream out(labels_tmp, std::ios::binary);
+    out << renderer.labels_json(labels).dump(1) << "\n";
+    if (!out) throw std::runtime_error(labels_tmp.string() + ": cannot write (disk full?)");
+  }
+  // The labels last: a folder with labels.json is complete.
+  fs::rename(video_tmp, out_dir / "video.mp4");
+  fs::rename(labels_tmp, out_dir / "labels.json");
+}
+
+fs::path cached_fixture(const fs::path& recipe_path, const fs::path& cache_dir,
+                        const Progress& progress) {
+  const sim::Recipe recipe = sim::load_recipe(recipe_path);
+  std::uint64_t h = fnv1a(sim::to_json(recipe).dump());
+  h = fnv1a(read_text(sim::default_hand_model_path()), h);
+  h = fnv1a(kRendererVersion, h);
+  char hex[17];
+  std::snprintf(hex, sizeof(hex), "%016llx", static_cast<unsigned long long>(h));
+  const fs::path dir = cache_dir / (recipe_path.stem().string() + "-" + std::string(hex, 12));
+  if (fs::exists(dir / "labels.json") && fs::exists(dir / "video.mp4")) return dir;
+  render_fixture(recipe_path, dir, progress);
+  return dir;
+}
+
+std::unique_ptr<vision::CaptureSource> open_recipe_source(std::string_view spec,
+                                                          const contracts::Clock& clock) {
+  std::string rest(spec.substr(7));  // after "recipe:"
+  bool live = false;
+  if (const auto q = rest.find('?'); q != std::string::npos) {
+    const std::string query = rest.substr(q + 1);
+    rest = rest.substr(0, q);
+    if (query == "live=1" || query == "live=true") {
+      live = true;
+    } else if (query != "live=0" && query != "live=false") {
+      throw vision::CaptureError(std::string(spec) + ": unknown option \"" + query +
+                                 "\"; the only option is ?live=1");
+    }
+  }
+  sim::Recipe recipe;
+  try {
+    recipe = sim::load_recipe(rest);
+  } catch (const sim::RecipeError& e) {
+    throw vision::CaptureError(e.what());
+  }
+  // The renderer (and its GL context) is made on the capture thread, on the first frame.
+  auto renderer = std::make_shared<std::unique_ptr<sim::FixtureRenderer>>();
+  auto start = std::make_shared<contracts::Duration>();
+  const contracts::Clock* c = &clock;
+  auto generate = [renderer, recipe, live, start, c](std::int64_t id) -> std::optional<cv::Mat> {
+    if (!*renderer) {
+      *renderer = std::make_unique<sim::FixtureRenderer>(recipe);
+      *start = c->now();
+    }
+    sim::FixtureRenderer& r = **renderer;
+    const auto n = r.frame_count();
+    if (!live && id >= n) return std::nullopt;
+    cv::Mat bgr = r.frame(id % n).bgr;
+    if (live) {
+      const auto due = *start + contracts::from_seconds(static_cast<double>(id) / recipe.fps);
+      const auto now = c->now();
+      if (due > now) std::this_thread::sleep_for(due - now);
+    }
+    return bgr;
+  };
+  return std::make_unique<vision::GeneratorSource>(generate, clock, std::string(spec), live,
+                                                   vision::PixelOrder::kBgr);
+}
+
+Progress terminal_progress(std::string label) {
+  if (isatty(STDERR_FILENO) == 0) return {};
+  return [label = std::move(label)](std::int64_t done, std::int64_t total) {
+    constexpr int kWidth = 30;
+    const int filled = total > 0 ? static_cast<int>(kWidth * done / total) : kWidth;
+    std::cerr << "\r" << label << " [" << std::string(filled, '#')
+              << std::string(kWidth - filled, ' ') << "] " << done << "/" << total << " frames"
+              << (done == total ? "\n" : "") << std::flush;
+  };
+}
+
+}  // namespace gbdcs::app

@@ -1,0 +1,94 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <opencv2/core.hpp>
+#include <string>
+#include <random>
+
+#include "gbdcs/sim/hand_scene.hpp"
+
+namespace gbdcs::sim {
+namespace {
+
+// The MuJoCo hand's landmark sites, in the hand's own frame, are where the kinematic hand
+// of sim/landmarks puts them: the articulated model and the pose library agree joint for
+// joint, so a pose from the library renders as the hand it describes.
+TEST(HandScene, SitesMatchTheKinematicHandForEveryPose) {
+  HandScene scene(160, 120);
+  const mjModel* m = scene.model();
+  const int hand = mj_name2id(m, mjOBJ_BODY, "hand");
+  ASSERT_GE(hand, 0);
+  std::mt19937 rng(7);
+  for (PoseName name : kAllPoses) {
+    for (int variant = 0; variant < 3; ++variant) {
+      HandInstance h;
+      h.pose = pose_for(name, rng);
+      scene.project(h);
+      const mjData* d = scene.data();
+      const auto expected = hand_points_mm(h.pose);
+      const char* names[21] = {"lm_wrist",      "lm_thumb_cmc",  "lm_thumb_mcp",  "lm_thumb_ip",
+                               "lm_thumb_tip",  "lm_index_mcp",  "lm_index_pip",  "lm_index_dip",
+                               "lm_index_tip",  "lm_middle_mcp", "lm_middle_pip", "lm_middle_dip",
+                               "lm_middle_tip", "lm_ring_mcp",   "lm_ring_pip",   "lm_ring_dip",
+                               "lm_ring_tip",   "lm_pinky_mcp",  "lm_pinky_pip",  "lm_pinky_dip",
+                               "lm_pinky_tip"};
+      for (std::size_t i = 0; i < 21; ++i) {
+        const int s = mj_name2id(m, mjOBJ_SITE, names[i]);
+        ASSERT_GE(s, 0) << names[i];
+        double rel[3], local[3];
+        for (int c = 0; c < 3; ++c) rel[c] = d->site_xpos[3 * s + c] - d->xpos[3 * hand + c];
+        mju_mulMatTVec(local, d->xmat + 9 * hand, rel, 3, 3);
+        EXPECT_NEAR(local[0] * 1000, expected[i].x, 0.5) << to_string(name) << " " << names[i];
+        EXPECT_NEAR(local[1] * 1000, expected[i].y, 0.5) << to_string(name) << " " << names[i];
+        EXPECT_NEAR(local[2] * 1000, expected[i].z, 0.5) << to_string(name) << " " << names[i];
+      }
+    }
+  }
+}
+
+TEST(HandScene, ProjectsThePalmCentreWhereItWasPlaced) {
+  HandScene scene(320, 240);
+  std::mt19937 rng(3);
+  HandInstance h;
+  h.pose = pose_for(PoseName::kOpenPalm, rng);
+  h.pose.orientation = {};
+  h.center_x = 0.3;
+  h.center_y = 0.6;
+  h.distance_m = 0.8;
+  const auto p = scene.project(h);
+  // Wrist below the palm centre, middle knuckle above it, both near x = 0.3.
+  EXPECT_NEAR(p.points[0].x, 0.3, 0.01);
+  EXPECT_GT(p.points[0].y, 0.6);
+  EXPECT_LT(p.points[9].y, 0.6);
+  // Hand length 183 mm at 0.8 m: f * 0.183 / 0.8 pixels.
+  const double length_px = std::hypot((p.points[12].x - p.points[0].x) * 320,
+                                      (p.points[12].y - p.points[0].y) * 240);
+  EXPECT_NEAR(length_px, scene.focal_px() * 0.183 / 0.8, 0.06 * length_px);
+}
+
+TEST(HandScene, LeftHandIsTheMirrorImageOfTheRightOne) {
+  HandScene scene(320, 240);
+  std::mt19937 rng(5);
+  HandInstance right;
+  // Without an aim (which sim/landmarks applies after the mirroring, so that a left hand
+  // points the way it is told) a left hand is exactly the mirror image of a right one.
+  right.pose = pose_for(PoseName::kVictory, rng);
+  right.pose.orientation.aim_deg = 0;
+  right.center_x = 0.4;
+  HandInstance left = right;
+  left.handedness = contracts::Handedness::kLeft;
+  left.center_x = 0.6;
+  const auto r = scene.render(right);
+  const auto l = scene.render(left);
+  for (std::size_t i = 0; i < 21; ++i) {
+    EXPECT_NEAR(r.landmarks.points[i].x, 1 - l.landmarks.points[i].x, 1e-6);
+    EXPECT_NEAR(r.landmarks.points[i].y, l.landmarks.points[i].y, 1e-6);
+  }
+  cv::Mat flipped;
+  cv::flip(l.mask, flipped, 1);
+  EXPECT_EQ(cv::countNonZero(r.mask != flipped), 0);
+  EXPECT_GT(cv::countNonZero(r.mask), 500);
+}
+
+}  // namespace
+}  // namespace gbdcs::sim
