@@ -228,8 +228,14 @@ Tally eval_fixture(const fs::path& dir, vision::HandFinder& finder,
           }
         }
       }
-    } else if (l.value("hand_present", false) && !hands.empty()) {
-      match = &hands.front();
+    } else if (l.value("hand_present", false)) {
+      // A recorded fixture: no landmarks; the most present hand is the one shown, and the
+      // detection rate counts the frames the script asked for a hand (outside countdowns).
+      if (fully_visible && !transition) {
+        ++t.visible_frames;
+        if (!hands.empty()) ++t.detected_frames;
+      }
+      if (!hands.empty()) match = &hands.front();
     }
     if (transition) continue;
     GestureType predicted = match != nullptr ? match->gesture : GestureType::kNone;

@@ -86,6 +86,25 @@ TEST(FixtureRenderer, SameSeedSameLabelsAndPixels) {
   ASSERT_TRUE(label.landmarks);
 }
 
+// A segment with its own seed draws the same pose variant wherever it sits in the recipe.
+TEST(FixtureRenderer, SegmentSeedKeepsItsVariant) {
+  const auto a = recipe_from_json(json::parse(R"({"fps": 10, "segments": [
+      {"no_hand": true, "duration_s": 1.0},
+      {"pose": "FIST", "duration_s": 0.5, "seed": 42, "transition_s": 0}]})"));
+  const auto b = recipe_from_json(json::parse(R"({"fps": 10, "seed": 9, "segments": [
+      {"pose": "CALL", "duration_s": 1.0}, {"pose": "FIST", "duration_s": 0.5, "seed": 42,
+       "transition_s": 0}]})"));
+  FixtureRenderer ra(a);
+  FixtureRenderer rb(b);
+  const auto la = ra.label(12);
+  const auto lb = rb.label(12);
+  ASSERT_TRUE(la.landmarks && lb.landmarks);
+  for (std::size_t i = 0; i < contracts::kLandmarkCount; ++i) {
+    EXPECT_NEAR(la.landmarks->points[i].x, lb.landmarks->points[i].x, 1e-9);
+    EXPECT_NEAR(la.landmarks->points[i].y, lb.landmarks->points[i].y, 1e-9);
+  }
+}
+
 TEST(FixtureRenderer, LabelsJsonHasTheDocumentedShape) {
   FixtureRenderer r(small_recipe(2));
   std::vector<FrameLabel> labels;

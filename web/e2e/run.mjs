@@ -17,7 +17,6 @@
 /* global document, window, localStorage -- functions passed to page.evaluate run in the page */
 import { spawn, execFileSync } from 'node:child_process';
 import { existsSync, mkdirSync, mkdtempSync, rmSync, writeFileSync } from 'node:fs';
-import { createServer } from 'node:net';
 import { tmpdir } from 'node:os';
 import { join, resolve, dirname } from 'node:path';
 import { fileURLToPath } from 'node:url';
@@ -44,17 +43,6 @@ function fail(msg) {
 }
 
 const log = (m) => console.log(`web e2e: ${m}`);
-
-async function freePort() {
-  return new Promise((res, rej) => {
-    const s = createServer();
-    s.once('error', rej);
-    s.listen(0, '127.0.0.1', () => {
-      const { port } = s.address();
-      s.close(() => res(port));
-    });
-  });
-}
 
 async function waitHttp(url, ms, child) {
   const end = Date.now() + ms;
@@ -95,34 +83,49 @@ async function main() {
 
   mkdirSync(out, { recursive: true });
   const tmp = mkdtempSync(join(tmpdir(), 'gbdcs-web-e2e-'));
-  const port = await freePort();
-  const base = `http://127.0.0.1:${port}`;
   const serverLog = join(out, 'serve.log');
   const logFd = [];
+  // --port 0: the server picks a free port and prints it.
   const child = spawn(
     gbdcs,
     [
       'serve',
       '--port',
-      String(port),
+      '0',
       '--bind',
       '127.0.0.1',
       '--db',
       join(tmp, 'gbdcs.db'),
       '--adapter',
       'twin',
+      '--web',
+      join(repo, 'web', 'dist'),
     ],
-    {
-      cwd: repo,
-      env: { ...process.env, GBDCS_TOKEN_TTL_S: '1800' },
-      stdio: ['ignore', 'pipe', 'pipe'],
-    },
+    { cwd: repo, env: { ...process.env }, stdio: ['ignore', 'pipe', 'pipe'] },
   );
-  child.stdout.on('data', (d) => logFd.push(d));
-  child.stderr.on('data', (d) => logFd.push(d));
   let browser;
   const shots = [];
   try {
+    const base = await new Promise((res, rej) => {
+      let seen = '';
+      const timer = setTimeout(
+        () => rej(new Error(`gbdcs serve did not say where it listens within 120 s:\n${seen}`)),
+        120_000,
+      );
+      child.stdout.on('data', (d) => {
+        logFd.push(d);
+        seen += d.toString();
+        const m = /listening on (http:\/\/[0-9.]+:\d+)/.exec(seen);
+        if (m) {
+          clearTimeout(timer);
+          res(m[1]);
+        }
+      });
+      child.stderr.on('data', (d) => logFd.push(d));
+      child.once('exit', (code) =>
+        rej(new Error(`gbdcs serve exited with ${code}:\n${Buffer.concat(logFd)}`)),
+      );
+    });
     log(`gbdcs serve on ${base} (db in ${tmp})`);
     await waitHttp(`${base}/api/v1/healthz`, 120_000, child);
 

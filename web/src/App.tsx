@@ -142,6 +142,7 @@ export function App() {
   };
 
   const logout = async () => {
+    connRef.current?.stop(); // our own close first: the server's 4001 is then not needed
     try {
       await api.logout();
     } catch {
