@@ -20,7 +20,9 @@
 #include "gbdcs/vision/vision_messages.hpp"
 #include "gbdcs/vision/vision_pipeline.hpp"
 #include "source_factory.hpp"
+#include "vision_publish.hpp"
 #include "vision_support.hpp"
+#include "ws_publisher.hpp"
 
 namespace gbdcs::app {
 namespace {
@@ -56,14 +58,34 @@ struct VisionOptions {
   std::string publish;
   std::string options_file;
   double heartbeat_s = 1.0;
+  bool publish_jpeg = false;
+  int jpeg_width = 480;
 };
 
 int run_vision(const VisionOptions& o) {
-  if (!o.publish.empty()) {
-    std::cerr << "gbdcs vision: --publish " << o.publish
-              << " is not available until the server lands (the WebSocket comes with it); "
-                 "leave --publish out to get the same messages as JSON lines on stdout\n";
-    return 2;
+  // --publish: the same messages as WebSocket text messages to the server (INTERFACES.md 2).
+  std::unique_ptr<WsPublisher> publisher;
+  if (!o.publish.empty()) publisher = std::make_unique<WsPublisher>(o.publish);
+  std::mutex out_mutex;
+  std::atomic<bool> publish_failed{false};
+  auto emit = [&](const json& doc) {
+    std::lock_guard lock(out_mutex);
+    if (!publisher) {
+      std::cout << doc.dump() << '\n' << std::flush;
+      return;
+    }
+    try {
+      publisher->send(doc.dump());
+    } catch (const std::exception& e) {
+      if (!publish_failed.exchange(true)) std::cerr << "gbdcs vision: " << e.what() << "\n";
+      g_interrupted = true;
+    }
+  };
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+  if (o.source.rfind("timeline:", 0) == 0) {
+    run_timeline_worker(o.source, o.heartbeat_s, emit, g_interrupted);
+    return publish_failed ? 1 : 0;
   }
   quiet_opencv();
   contracts::SteadyClock clock;
@@ -72,8 +94,14 @@ int run_vision(const VisionOptions& o) {
     options = vision::pipeline_options_from_json(read_json_file(o.options_file));
   std::unique_ptr<vision::CaptureSource> source;
   std::unique_ptr<vision::HandFinder> finder;
+  JpegTap* tap = nullptr;
   try {
     source = open_any_source(o.source, clock);
+    if (o.publish_jpeg) {
+      auto wrapped = std::make_unique<JpegTap>(std::move(source), o.jpeg_width, 70);
+      tap = wrapped.get();
+      source = std::move(wrapped);
+    }
     // A folder holds unrelated stills: detect in each (MediaPipe's static image mode).
     const bool stills = o.source.rfind("images:", 0) == 0;
     finder = vision::make_tracker_finder(tracker_options(o.models, stills), clock);
@@ -85,17 +113,17 @@ int run_vision(const VisionOptions& o) {
     return 2;
   }
 
-  std::mutex out_mutex;
-  auto emit = [&](const json& doc) {
-    std::lock_guard lock(out_mutex);
-    std::cout << doc.dump() << '\n' << std::flush;
-  };
   vision::VisionPipeline pipeline(
       std::move(source), std::move(finder), clock,
-      [&](const vision::FrameResult& r) { emit(vision::frame_message(r)); }, options);
+      [&](const vision::FrameResult& r) {
+        auto doc = vision::frame_message(r);
+        if (tap) {
+          if (auto jpeg = tap->take(r.frame_id)) doc["jpeg"] = std::move(*jpeg);
+        }
+        emit(doc);
+      },
+      options);
 
-  std::signal(SIGINT, on_signal);
-  std::signal(SIGTERM, on_signal);
   pipeline.start();
   const auto period = contracts::from_seconds(o.heartbeat_s);
   auto next_beat = clock.now() + period;
@@ -290,7 +318,13 @@ void add_vision_commands(CLI::App& app) {
   vision_cmd->add_option("--source", v.source, "camera:N, video:PATH, images:DIR or recipe:PATH[?live=1]")->required();
   add_model_options(vision_cmd, v.models);
   vision_cmd->add_option("--publish", v.publish,
-                         "WebSocket URL to publish to (not available until the server lands)");
+                         "Send the messages to a WebSocket instead of stdout: "
+                         "ws://127.0.0.1:PORT/worker?secret=S (what gbdcs serve passes)");
+  vision_cmd->add_flag("--publish-jpeg", v.publish_jpeg,
+                       "Add a downscaled base64 JPEG of each frame to its frame message");
+  vision_cmd->add_option("--jpeg-width", v.jpeg_width, "Width of that JPEG, px")
+      ->capture_default_str()
+      ->check(CLI::Range(64, 1920));
   vision_cmd->add_option("--options", v.options_file,
                          "PipelineOptions JSON (queue_capacity, policy, resize_width, ...; "
                          "docs/VISION.md)");

@@ -97,8 +97,22 @@ CREATE TABLE config (
 );
 )sql";
 
-constexpr std::array<Migration, 1> kMigrations = {{
+// The server's auth: logged-out tokens stay refused until they would have expired anyway;
+// who acknowledged an alert.
+constexpr std::string_view kServerAuth = R"sql(
+CREATE TABLE revoked_tokens (
+  jti            TEXT    PRIMARY KEY,
+  user_id        INTEGER REFERENCES users(id) ON DELETE CASCADE,
+  expires_at_ms  INTEGER NOT NULL,
+  revoked_at_ms  INTEGER NOT NULL
+);
+CREATE INDEX revoked_tokens_expiry ON revoked_tokens(expires_at_ms);
+ALTER TABLE alerts ADD COLUMN acknowledged_by INTEGER REFERENCES users(id) ON DELETE SET NULL;
+)sql";
+
+constexpr std::array<Migration, 2> kMigrations = {{
     {1, "initial schema", kInitialSchema},
+    {2, "server auth: revoked tokens, alert acknowledged_by", kServerAuth},
 }};
 
 constexpr std::string_view kCreateMigrationsTable = R"sql(

@@ -63,6 +63,18 @@ class StorageManager {
                                           std::string_view password_hash);  // nullopt: name taken
   std::optional<UserRecord> find_user(std::string_view username) const;
   bool set_user_theme(std::int64_t user_id, std::string_view theme);  // false: no such user
+  std::optional<UserRecord> find_user_by_id(std::int64_t user_id) const;
+
+  // ---- revoked tokens (server logout; storage_auth.cpp) ----
+  // Records a token id as revoked until expires_at (then purge_revoked_tokens may drop it).
+  void revoke_token(std::string_view jti, std::optional<std::int64_t> user_id,
+                    contracts::UtcTime expires_at);
+  bool is_token_revoked(std::string_view jti) const;
+  std::int64_t purge_revoked_tokens();  // drops those expired by the clock's utc_now()
+  // The alert's session and acknowledgement, by the id acknowledge_alert takes.
+  std::optional<AlertRecord> find_alert(std::int64_t alert_id) const;
+  // As acknowledge_alert, also recording who (a user id).
+  bool acknowledge_alert_by(std::int64_t alert_id, std::optional<std::int64_t> user_id);
 
   // ---- sessions ----
   std::int64_t begin_session(std::optional<std::int64_t> user_id, std::string drone,

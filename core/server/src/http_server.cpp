@@ -1,0 +1,569 @@
+// The transport: Beast listener, HTTP sessions, /ws/live and /worker WebSocket sessions.
+// Routing and auth decisions live in api_routes.cpp and live_hub.cpp.
+#include <openssl/crypto.h>
+
+#include <utility>  // before Asio: its awaitable.hpp needs std::exchange
+
+#include <boost/asio.hpp>
+#include <boost/beast.hpp>
+#include <boost/beast/websocket.hpp>
+#include <thread>
+
+#include "api.hpp"
+#include "gbdcs/contracts/codec.hpp"
+#include "gbdcs/server/server.hpp"
+#include "static_files.hpp"
+
+namespace gbdcs::server {
+
+namespace beast = boost::beast;
+namespace http = beast::http;
+namespace websocket = beast::websocket;
+namespace net = boost::asio;
+using tcp = net::ip::tcp;
+using nlohmann::json;
+
+struct Server::Impl {
+  Impl(const contracts::Clock& c, storage::StorageManager& s, TokenService& t, DroneService& d,
+       LiveHub& h, ServerOptions o, EventLog l)
+      : clock(c), storage(s), tokens(t), drone(d), hub(h), options(std::move(o)), log(std::move(l)),
+        limiter(c), replays(c, s, h, d), ids(c),
+        ctx{c, s, t, d, h, metrics, replays, limiter, options, log}, acceptor(ioc) {}
+
+  const contracts::Clock& clock;
+  storage::StorageManager& storage;
+  TokenService& tokens;
+  DroneService& drone;
+  LiveHub& hub;
+  ServerOptions options;
+  EventLog log;
+  Metrics metrics;
+  LoginLimiter limiter;
+  ReplayManager replays;
+  UlidGenerator ids;
+  ApiContext ctx;
+  net::io_context ioc;
+  tcp::acceptor acceptor;
+  std::vector<std::thread> threads;
+  std::mutex worker_mutex;
+  WorkerHandlers worker;
+  bool stopped = false;
+
+  void accept();
+};
+
+namespace {
+
+using Request = http::request<http::string_body>;
+using Response = http::response<http::string_body>;
+
+Response to_http(const ApiResponse& a, unsigned version, bool keep_alive, const std::string& rid) {
+  Response res{static_cast<http::status>(a.status), version};
+  res.set(http::field::server, "gbdcs");
+  res.set("X-Request-Id", rid);
+  if (a.status != 204) res.set(http::field::content_type, a.content_type);
+  res.set(http::field::cache_control, "no-store");
+  for (const auto& [k, v] : a.headers) res.set(k, v);
+  res.keep_alive(keep_alive);
+  res.body() = a.body;
+  res.prepare_payload();
+  return res;
+}
+
+std::map<std::string, std::string> parse_query(std::string_view q) {
+  std::map<std::string, std::string> out;
+  while (!q.empty()) {
+    auto amp = q.find('&');
+    auto pair = q.substr(0, amp);
+    auto eq = pair.find('=');
+    auto key = percent_decode(pair.substr(0, eq), true);
+    auto value = eq == std::string_view::npos ? std::string() : percent_decode(pair.substr(eq + 1), true);
+    if (!key.empty()) out[key] = value;
+    if (amp == std::string_view::npos) break;
+    q = q.substr(amp + 1);
+  }
+  return out;
+}
+
+bool is_loopback(const tcp::endpoint& e) { return e.address().is_loopback(); }
+
+// ---- /ws/live ---------------------------------------------------------------------------
+class LiveSession final : public LiveClient, public std::enable_shared_from_this<LiveSession> {
+ public:
+  LiveSession(tcp::socket socket, Server::Impl& impl, TokenClaims claims)
+      : ws_(std::move(socket)), impl_(impl), claims_(std::move(claims)) {}
+
+  void start(Request req) {
+    ws_.set_option(websocket::stream_base::timeout::suggested(beast::role_type::server));
+    ws_.read_message_max(impl_.options.max_ws_message_bytes);
+    ws_.async_accept(req, [self = shared_from_this()](beast::error_code ec) {
+      if (ec) return;
+      self->impl_.hub.add(self);
+      self->deliver(self->impl_.hub.make("state", self->impl_.drone.state()));
+      self->read();
+    });
+  }
+
+  void deliver(const OutMessagePtr& m) override {
+    bool start_write = false, too_slow = false;
+    {
+      std::lock_guard lock(mutex_);
+      if (closed_) return;
+      too_slow = !queue_.push(m);
+      if (!writing_) start_write = writing_ = true;
+    }
+    if (too_slow) close_with(1008, "client too slow: alerts backed up");
+    if (start_write) net::post(ws_.get_executor(), [self = shared_from_this()] { self->write_next(); });
+  }
+
+  void close_with(int code, const std::string& reason) override {
+    net::post(ws_.get_executor(), [self = shared_from_this(), code, reason] {
+      if (self->closing_) return;
+      self->closing_ = true;
+      self->ws_.async_close(websocket::close_reason(static_cast<websocket::close_code>(code), reason),
+                            [self](beast::error_code) { self->finish(); });
+    });
+  }
+  const std::string& token_id() const override { return claims_.jti; }
+  contracts::UtcTime token_expires() const override { return claims_.expires_at; }
+  std::uint64_t dropped() const override {
+    std::lock_guard lock(mutex_);
+    return queue_.dropped();
+  }
+  std::size_t queued() const override {
+    std::lock_guard lock(mutex_);
+    return queue_.size();
+  }
+
+ private:
+  void finish() {
+    {
+      std::lock_guard lock(mutex_);
+      closed_ = true;
+    }
+    impl_.hub.remove(this);
+  }
+
+  void write_next() {
+    {
+      std::lock_guard lock(mutex_);
+      auto next = queue_.pop();
+      if (!next || closed_) {
+        writing_ = false;
+        return;
+      }
+      current_ = *next;
+    }
+    ws_.text(true);
+    ws_.async_write(net::buffer(current_->text),
+                    [self = shared_from_this()](beast::error_code ec, std::size_t) {
+                      if (ec) {
+                        self->finish();
+                        std::lock_guard lock(self->mutex_);
+                        self->writing_ = false;
+                        return;
+                      }
+                      self->impl_.metrics.ws_delivery_ms.observe(
+                          contracts::to_seconds(self->impl_.clock.now() - self->current_->enqueued) *
+                          1000.0);
+                      self->write_next();
+                    });
+  }
+
+  void read() {
+    ws_.async_read(buffer_, [self = shared_from_this()](beast::error_code ec, std::size_t) {
+      if (ec) {
+        self->finish();
+        return;
+      }
+      std::string text = beast::buffers_to_string(self->buffer_.data());
+      self->buffer_.consume(self->buffer_.size());
+      self->on_message(text);
+      self->read();
+    });
+  }
+
+  void reply_error(const std::string& code, const std::string& cause, const std::string& suggestion) {
+    deliver(impl_.hub.make("error", {{"error", code}, {"cause", cause},
+                                     {"suggestion", suggestion}, {"request_id", impl_.ids.next()}}));
+  }
+
+  void on_message(const std::string& text) {
+    json doc;
+    try {
+      doc = contracts::parse_json(text);
+    } catch (const std::exception& e) {
+      return reply_error("malformed_json", e.what(), "send one JSON object per message");
+    }
+    const std::string type = doc.is_object() && doc.contains("type") && doc["type"].is_string()
+                                 ? doc["type"].get<std::string>() : "";
+    std::string schema;
+    if (type == "ack") schema = "ws_ack";
+    else if (type == "input") schema = "ws_input";
+    else if (type == "emergency_stop") schema = "ws_emergency_stop";
+    else return reply_error("invalid_message", "unknown message type '" + type.substr(0, 40) + "'",
+                            "send type ack, input or emergency_stop (docs/API.md)");
+    try {
+      contracts::validate(schema, doc);
+    } catch (const contracts::ContractError& e) {
+      return reply_error("invalid_message", e.what(),
+                         "see core/contracts/schemas/" + schema + ".schema.json");
+    }
+    if (type == "emergency_stop") {
+      impl_.drone.emergency_stop(contracts::CommandSource::kApi,
+                                 "ws:user:" + std::to_string(claims_.user_id));
+    } else if (type == "input") {
+      impl_.drone.key(doc["key"].get<std::string>(), doc["pressed"].get<bool>());
+    } else {
+      const auto id = doc["alert_id"].get<std::int64_t>();
+      if (!impl_.storage.acknowledge_alert_by(id, claims_.user_id)) {
+        return reply_error("not_found", "there is no alert " + std::to_string(id),
+                           "acknowledge the data.id of an alert message");
+      }
+      auto a = impl_.storage.find_alert(id);
+      if (impl_.log) impl_.log("info", {{"event", "alert_ack"}, {"alert_id", id},
+                                        {"user_id", claims_.user_id}});
+      deliver(impl_.hub.make(
+          "ack_result", {{"alert_id", id},
+                         {"acknowledged_at", contracts::format_utc(a && a->acknowledged_at
+                                                                        ? *a->acknowledged_at
+                                                                        : impl_.clock.utc_now())}}));
+    }
+  }
+
+  websocket::stream<beast::tcp_stream> ws_;
+  Server::Impl& impl_;
+  TokenClaims claims_;
+  beast::flat_buffer buffer_;
+  mutable std::mutex mutex_;
+  ClientQueue queue_;
+  bool writing_ = false;
+  bool closed_ = false;
+  bool closing_ = false;
+  OutMessagePtr current_;
+};
+
+// ---- /worker ----------------------------------------------------------------------------
+class WorkerSession final : public std::enable_shared_from_this<WorkerSession> {
+ public:
+  WorkerSession(tcp::socket socket, Server::Impl& impl) : ws_(std::move(socket)), impl_(impl) {}
+  void start(Request req) {
+    ws_.read_message_max(8 << 20);  // frames carry a JPEG
+    ws_.async_accept(req, [self = shared_from_this()](beast::error_code ec) {
+      if (ec) return;
+      WorkerHandlers h;
+      {
+        std::lock_guard lock(self->impl_.worker_mutex);
+        h = self->impl_.worker;
+      }
+      if (h.connected) h.connected();
+      self->read();
+    });
+  }
+
+ private:
+  void read() {
+    ws_.async_read(buffer_, [self = shared_from_this()](beast::error_code ec, std::size_t) {
+      WorkerHandlers h;
+      {
+        std::lock_guard lock(self->impl_.worker_mutex);
+        h = self->impl_.worker;
+      }
+      if (ec) {
+        if (h.closed) h.closed();
+        return;
+      }
+      const auto text = beast::buffers_to_string(self->buffer_.data());
+      self->buffer_.consume(self->buffer_.size());
+      try {
+        auto doc = contracts::parse_json(text);
+        const auto type = doc.value("type", "");
+        contracts::validate(type == "heartbeat" ? "vision_heartbeat" : "vision_frame", doc);
+        if (h.message) h.message(doc);
+      } catch (const std::exception& e) {
+        if (self->impl_.log) self->impl_.log("warn", {{"event", "worker_bad_message"}, {"cause", e.what()}});
+      }
+      self->read();
+    });
+  }
+  websocket::stream<beast::tcp_stream> ws_;
+  Server::Impl& impl_;
+  beast::flat_buffer buffer_;
+};
+
+// ---- HTTP -------------------------------------------------------------------------------
+class HttpSession final : public std::enable_shared_from_this<HttpSession> {
+ public:
+  HttpSession(tcp::socket socket, Server::Impl& impl) : stream_(std::move(socket)), impl_(impl) {}
+  void run() {
+    net::dispatch(stream_.get_executor(), [self = shared_from_this()] { self->read(); });
+  }
+
+ private:
+  void read() {
+    parser_.emplace();
+    parser_->body_limit(impl_.options.max_body_bytes);
+    parser_->header_limit(16 * 1024);
+    stream_.expires_after(std::chrono::seconds(30));
+    http::async_read(stream_, buffer_, *parser_,
+                     [self = shared_from_this()](beast::error_code ec, std::size_t) {
+                       self->on_read(ec);
+                     });
+  }
+
+  void on_read(beast::error_code ec) {
+    if (ec == http::error::end_of_stream || ec == net::error::operation_aborted ||
+        ec == beast::error::timeout || ec == net::error::eof || ec == net::error::connection_reset) {
+      beast::error_code ignored;
+      stream_.socket().shutdown(tcp::socket::shutdown_send, ignored);
+      return;
+    }
+    if (ec) {
+      const auto rid = impl_.ids.next();
+      const bool too_large = ec == http::error::body_limit || ec == http::error::header_limit;
+      ApiError e(too_large ? 413 : 400, too_large ? "body_too_large" : "malformed_request",
+                 too_large ? "the request is larger than " +
+                                 std::to_string(impl_.options.max_body_bytes) + " bytes"
+                           : "the HTTP request cannot be parsed: " + ec.message(),
+                 too_large ? "send a smaller body (GBDCS_MAX_BODY_BYTES sets the limit)"
+                           : "send a well-formed HTTP/1.1 request");
+      auto a = error_response(e, rid);
+      log_request(rid, "?", "?", a, 0);
+      send(to_http(a, 11, false, rid), true);
+      return;
+    }
+    Request req = parser_->release();
+    if (websocket::is_upgrade(req)) return upgrade(std::move(req));
+    handle(std::move(req));
+  }
+
+  void log_request(const std::string& rid, const std::string& method, const std::string& path,
+                   const ApiResponse& a, double ms) {
+    impl_.metrics.count_request(a.status);
+    impl_.metrics.request_ms.observe(ms);
+    if (!impl_.log) return;
+    json e = {{"event", "http"}, {"request_id", rid}, {"method", method},
+              {"path", path.substr(0, 200)}, {"status", a.status}, {"ms", ms},
+              {"remote", remote()}};
+    if (!a.log_detail.empty()) e["cause"] = a.log_detail;
+    impl_.log(a.status >= 500 ? "error" : (a.status >= 400 ? "warn" : "info"), e);
+  }
+
+  std::string remote() const {
+    beast::error_code ec;
+    auto ep = stream_.socket().remote_endpoint(ec);
+    return ec ? std::string("?") : ep.address().to_string();
+  }
+
+  ApiResponse dispatch(const Request& req, const std::string& rid, std::string& path) {
+    const std::string target(req.target());
+    const auto qpos = target.find('?');
+    path = percent_decode(std::string_view(target).substr(0, qpos), false);
+    ApiRequest ar;
+    ar.method = std::string(req.method_string());
+    ar.path = path;
+    if (qpos != std::string::npos) ar.query = parse_query(std::string_view(target).substr(qpos + 1));
+    ar.body = req.body();
+    ar.content_type = std::string(req[http::field::content_type]);
+    ar.authorization = std::string(req[http::field::authorization]);
+    ar.remote = remote();
+    ar.request_id = rid;
+    try {
+      if (path == "/metrics") ar.path = "/api/v1/metrics";
+      if (ar.path == "/api/v1" || ar.path.rfind("/api/v1/", 0) == 0) return handle_api(impl_.ctx, ar);
+      if (ar.path.rfind("/api/", 0) == 0 || ar.path == "/ws/live" || ar.path == "/worker") {
+        throw ApiError(404, "not_found", "there is no route " + ar.method + " " + path.substr(0, 200),
+                       "the API is under /api/v1 (GET /api/v1/openapi.json); /ws/live needs a "
+                       "WebSocket upgrade");
+      }
+      if (req.method() != http::verb::get && req.method() != http::verb::head) {
+        ApiError e(405, "method_not_allowed", "static files are read-only", "use GET");
+        e.headers.emplace_back("Allow", "GET, HEAD");
+        throw e;
+      }
+      return serve_static(impl_.options.web_dir, path);
+    } catch (const ApiError& e) {
+      return error_response(e, rid);
+    } catch (const std::exception& e) {
+      return error_response(ApiError(500, "internal", e.what(),
+                                     "retry; if it persists, report the request id with the "
+                                     "server log"),
+                            rid);
+    }
+  }
+
+  void handle(Request req) {
+    const auto t0 = impl_.clock.now();
+    const auto rid = impl_.ids.next();
+    std::string path;
+    auto a = dispatch(req, rid, path);
+    log_request(rid, std::string(req.method_string()), path, a,
+                contracts::to_seconds(impl_.clock.now() - t0) * 1000.0);
+    auto res = to_http(a, req.version(), req.keep_alive(), rid);
+    if (req.method() == http::verb::head) {
+      const auto length = res.body().size();
+      res.body().clear();
+      res.content_length(length);
+    }
+    send(std::move(res), !req.keep_alive());
+  }
+
+  void send(Response res, bool close) {
+    auto sp = std::make_shared<Response>(std::move(res));
+    http::async_write(stream_, *sp,
+                      [self = shared_from_this(), sp, close](beast::error_code ec, std::size_t) {
+                        if (ec || close) {
+                          beast::error_code ignored;
+                          self->stream_.socket().shutdown(tcp::socket::shutdown_send, ignored);
+                          return;
+                        }
+                        self->read();
+                      });
+  }
+
+  void refuse(const ApiError& e, const Request& req) {
+    impl_.metrics.ws_rejected++;
+    const auto rid = impl_.ids.next();
+    auto a = error_response(e, rid);
+    log_request(rid, "GET", std::string(req.target()).substr(0, std::string(req.target()).find('?')), a, 0);
+    send(to_http(a, req.version(), false, rid), true);
+  }
+
+  bool origin_allowed(const Request& req) const {
+    const auto origin = std::string(req[http::field::origin]);
+    if (origin.empty()) return true;  // not a browser
+    const auto host = std::string(req[http::field::host]);
+    if (origin == "http://" + host || origin == "https://" + host) return true;
+    for (const auto& o : impl_.options.allowed_origins) {
+      if (o == origin) return true;
+    }
+    return false;
+  }
+
+  void upgrade(Request req) {
+    const std::string target(req.target());
+    const auto qpos = target.find('?');
+    const auto path = target.substr(0, qpos);
+    const auto query = qpos == std::string::npos ? std::map<std::string, std::string>{}
+                                                 : parse_query(std::string_view(target).substr(qpos + 1));
+    if (path == "/ws/live") {
+      if (!origin_allowed(req)) {
+        return refuse(ApiError(403, "forbidden_origin",
+                               "WebSocket from origin '" + std::string(req[http::field::origin]).substr(0, 100) +
+                                   "' is not allowed",
+                               "open the dashboard from this server, or add the origin to "
+                               "GBDCS_ALLOWED_ORIGINS"),
+                      req);
+      }
+      TokenClaims claims;
+      try {
+        auto it = query.find("token");
+        claims = authenticate(impl_.ctx, it == query.end() ? "" : it->second);
+      } catch (const ApiError& e) {
+        return refuse(e, req);
+      }
+      stream_.expires_never();
+      std::make_shared<LiveSession>(stream_.release_socket(), impl_, claims)->start(std::move(req));
+      return;
+    }
+    if (path == "/worker") {
+      beast::error_code ec;
+      const auto ep = stream_.socket().remote_endpoint(ec);
+      auto it = query.find("secret");
+      const auto& want = impl_.options.worker_secret;
+      const bool secret_ok = !want.empty() && it != query.end() && it->second.size() == want.size() &&
+                             CRYPTO_memcmp(it->second.data(), want.data(), want.size()) == 0;
+      if (ec || !is_loopback(ep) || !secret_ok) {
+        return refuse(ApiError(403, "forbidden", "the vision worker endpoint takes only the worker "
+                                                 "this server started (loopback, per-run secret)",
+                               "do not connect to /worker yourself; use /ws/live"),
+                      req);
+      }
+      stream_.expires_never();
+      std::make_shared<WorkerSession>(stream_.release_socket(), impl_)->start(std::move(req));
+      return;
+    }
+    refuse(ApiError(404, "not_found", "no WebSocket at " + path.substr(0, 200), "use /ws/live?token=..."), req);
+  }
+
+  beast::tcp_stream stream_;
+  Server::Impl& impl_;
+  beast::flat_buffer buffer_;
+  std::optional<http::request_parser<http::string_body>> parser_;
+};
+
+}  // namespace
+
+void Server::Impl::accept() {
+  acceptor.async_accept(net::make_strand(ioc), [this](beast::error_code ec, tcp::socket socket) {
+    if (ec == net::error::operation_aborted || !acceptor.is_open()) return;
+    if (!ec) std::make_shared<HttpSession>(std::move(socket), *this)->run();
+    accept();
+  });
+}
+
+Server::Server(const contracts::Clock& clock, storage::StorageManager& storage,
+               TokenService& tokens, DroneService& drone, LiveHub& hub, ServerOptions options,
+               EventLog log)
+    : impl_(std::make_unique<Impl>(clock, storage, tokens, drone, hub, std::move(options),
+                                   std::move(log))) {
+  auto& m = impl_->metrics;
+  m.gauge("gbdcs_ws_clients", "Connected /ws/live clients",
+          [&h = hub] { return static_cast<double>(h.client_count()); });
+  m.gauge("gbdcs_ws_queue_depth", "Messages waiting in all client queues",
+          [&h = hub] { return static_cast<double>(h.queued_total()); });
+  m.gauge("gbdcs_ws_dropped_total", "Messages dropped for slow clients",
+          [&h = hub] { return static_cast<double>(h.dropped_total()); });
+  m.gauge("gbdcs_ws_broadcasts_total", "Messages broadcast",
+          [&h = hub] { return static_cast<double>(h.broadcast_total()); });
+  m.gauge("gbdcs_drone_connected", "1 when a drone is connected",
+          [&d = drone] { return d.connected() ? 1.0 : 0.0; });
+  m.gauge("gbdcs_storage_write_failures", "Failed SQLite writes",
+          [&s = storage] { return static_cast<double>(s.write_failures()); });
+}
+
+Server::~Server() { stop(); }
+
+void Server::set_worker_handlers(WorkerHandlers handlers) {
+  std::lock_guard lock(impl_->worker_mutex);
+  impl_->worker = std::move(handlers);
+}
+
+void Server::start() {
+  auto& i = *impl_;
+  beast::error_code ec;
+  const auto address = net::ip::make_address(i.options.bind, ec);
+  if (ec) throw std::runtime_error("--bind " + i.options.bind + " is not an IP address (e.g. 127.0.0.1)");
+  tcp::endpoint ep(address, i.options.port);
+  i.acceptor.open(ep.protocol(), ec);
+  if (!ec) i.acceptor.set_option(net::socket_base::reuse_address(true), ec);
+  if (!ec) i.acceptor.bind(ep, ec);
+  if (!ec) i.acceptor.listen(net::socket_base::max_listen_connections, ec);
+  if (ec) {
+    throw std::runtime_error("cannot listen on " + i.options.bind + ":" +
+                             std::to_string(i.options.port) + ": " + ec.message() +
+                             " (another server on that port? choose one with --port)");
+  }
+  i.accept();
+  for (int t = 0; t < std::max(1, i.options.threads); ++t) i.threads.emplace_back([&i] { i.ioc.run(); });
+}
+
+void Server::stop() {
+  auto& i = *impl_;
+  if (i.stopped) return;
+  i.stopped = true;
+  i.replays.stop_all();
+  net::post(i.ioc, [&i] {
+    beast::error_code ec;
+    i.acceptor.close(ec);
+  });
+  i.ioc.stop();
+  for (auto& t : i.threads) {
+    if (t.joinable()) t.join();
+  }
+}
+
+unsigned short Server::port() const { return impl_->acceptor.local_endpoint().port(); }
+Metrics& Server::metrics() { return impl_->metrics; }
+
+}  // namespace gbdcs::server
