@@ -7,6 +7,7 @@
 #include <fstream>
 #include <iostream>
 #include <sstream>
+#include <algorithm>
 #include <thread>
 
 #include "gbdcs/sim/fixture_renderer.hpp"
@@ -102,29 +103,42 @@ std::unique_ptr<vision::CaptureSource> open_recipe_source(std::string_view spec,
   }
   sim::Recipe recipe;
   try {
-    recipe = sim::load_recipe(rest);
+    recipe = sim::load_recipe(sim::resolve_fixture_path(rest));
   } catch (const sim::RecipeError& e) {
     throw vision::CaptureError(e.what());
   }
   // The renderer (and its GL context) is made on the capture thread, on the first frame.
-  auto renderer = std::make_shared<std::unique_ptr<sim::FixtureRenderer>>();
-  auto start = std::make_shared<contracts::Duration>();
+  // Live: the recipe's frame is the one due by the clock (frames are skipped when rendering
+  // falls behind real time, as a camera's are), looping forever.
+  struct State {
+    std::unique_ptr<sim::FixtureRenderer> renderer;
+    contracts::Duration start{};
+    std::int64_t last = -1;
+  };
+  auto state = std::make_shared<State>();
   const contracts::Clock* c = &clock;
-  auto generate = [renderer, recipe, live, start, c](std::int64_t id) -> std::optional<cv::Mat> {
-    if (!*renderer) {
-      *renderer = std::make_unique<sim::FixtureRenderer>(recipe);
-      *start = c->now();
+  auto generate = [state, recipe, live, c](std::int64_t id) -> std::optional<cv::Mat> {
+    if (!state->renderer) {
+      state->renderer = std::make_unique<sim::FixtureRenderer>(recipe);
+      state->start = c->now();
     }
-    sim::FixtureRenderer& r = **renderer;
+    sim::FixtureRenderer& r = *state->renderer;
     const auto n = r.frame_count();
-    if (!live && id >= n) return std::nullopt;
-    cv::Mat bgr = r.frame(id % n).bgr;
-    if (live) {
-      const auto due = *start + contracts::from_seconds(static_cast<double>(id) / recipe.fps);
-      const auto now = c->now();
-      if (due > now) std::this_thread::sleep_for(due - now);
+    if (!live) {
+      if (id >= n) return std::nullopt;
+      return r.frame(id).bgr;
     }
-    return bgr;
+    std::int64_t next = state->last + 1;
+    const auto due = state->start + contracts::from_seconds(static_cast<double>(next) / recipe.fps);
+    const auto now = c->now();
+    if (due > now) {
+      std::this_thread::sleep_for(due - now);
+    } else {
+      next = std::max(next, static_cast<std::int64_t>(contracts::to_seconds(now - state->start) *
+                                                      recipe.fps));
+    }
+    state->last = next;
+    return r.frame(next % n).bgr;
   };
   return std::make_unique<vision::GeneratorSource>(generate, clock, std::string(spec), live,
                                                    vision::PixelOrder::kBgr);

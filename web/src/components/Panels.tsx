@@ -163,7 +163,7 @@ export function AlertBanners({ alerts, onAck, onDismiss }: AlertProps) {
 
 export function CommandLog({ live }: { live: LiveState }) {
   return (
-    <section className="panel command-log" aria-labelledby="cmdlog-h">
+    <section className="panel command-log" aria-labelledby="cmdlog-h" data-testid="command-log">
       <h2 id="cmdlog-h">Commands</h2>
       {live.commands.length === 0 ? (
         <p className="muted">No commands yet.</p>
