@@ -22,6 +22,7 @@ namespace {
 struct FlyOptions {
   std::string timeline = "fixtures/timelines/demo_flight.json";
   std::string adapter = "dummy";
+  std::string adapter_options;  // JSON object text (docs/ADAPTERS.md)
   std::string profile;
   std::string db = "var/gbdcs.db";
   bool no_db = false;
@@ -78,7 +79,15 @@ int run_fly(const FlyOptions& o) {
   const contracts::Clock& clock =
       o.realtime ? static_cast<const contracts::Clock&>(steady_clock) : manual_clock;
 
-  auto adapter = make_drone(o.adapter, clock);
+  nlohmann::json adapter_options;
+  if (!o.adapter_options.empty()) {
+    adapter_options = nlohmann::json::parse(o.adapter_options, nullptr, false);
+    if (adapter_options.is_discarded() || !adapter_options.is_object()) {
+      throw std::invalid_argument("--adapter-options must be a JSON object, e.g. "
+                                  "'{\"address\": \"192.168.10.1\"}'");
+    }
+  }
+  auto adapter = make_drone(o.adapter, clock, adapter_options);
   gesture::GestureEngine engine(clock, std::make_unique<gesture::RuleBasedRecognizer>());
   control::CommandTranslator translator(profile);
   runtime::ControlLoop loop(clock, *adapter, engine, translator);
@@ -166,6 +175,9 @@ void add_fly_command(CLI::App& app) {
   cmd->add_option("--timeline", o.timeline, "Gesture timeline JSON (docs/TIMELINES.md)")
       ->capture_default_str();
   cmd->add_option("--adapter", o.adapter, "Drone adapter")->capture_default_str();
+  cmd->add_option("--adapter-options", o.adapter_options,
+                  "The adapter's options as a JSON object (docs/ADAPTERS.md), e.g. "
+                  "'{\"address\": \"127.0.0.1\"}' for a Tello emulated by `gbdcs twin --tello`");
   cmd->add_option("--profile", o.profile, "Gesture profile JSON (default: the built-in one)");
   cmd->add_option("--db", o.db, "SQLite database for the session log")->capture_default_str();
   cmd->add_flag("--no-db", o.no_db, "Do not record the session");

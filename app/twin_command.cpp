@@ -20,6 +20,7 @@
 #include "gbdcs/sim/trajectory_plot.hpp"
 #include "gbdcs/sim/twin_adapter.hpp"
 #include "gbdcs/sim/video_recorder.hpp"
+#include "twin_emulators.hpp"
 
 namespace gbdcs::app {
 namespace {
@@ -235,9 +236,10 @@ void add_twin_command(CLI::App& app) {
   cmd->add_option("--fps", o.fps, "Video frames per simulated second")
       ->capture_default_str()
       ->check(CLI::Range(1.0, 240.0));
+  add_twin_emulator_options(cmd);
   cmd->callback([] {
     try {
-      g_exit_code = run_twin(o);
+      g_exit_code = twin_emulators_requested() ? run_twin_emulators() : run_twin(o);
     } catch (const std::exception& e) {
       std::cerr << "gbdcs twin: " << e.what() << "\n";
       g_exit_code = 2;

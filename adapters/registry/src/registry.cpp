@@ -4,7 +4,9 @@
 #include <stdexcept>
 #include <utility>
 
+#include "gbdcs/adapters/airsim_adapter.hpp"
 #include "gbdcs/adapters/dummy_adapter.hpp"
+#include "gbdcs/adapters/tello_adapter.hpp"
 
 namespace gbdcs::adapters {
 namespace {
@@ -18,6 +20,14 @@ const std::vector<std::pair<std::string, Maker>>& entries() {
        [](const contracts::Clock& clock, const nlohmann::json& options) {
          return std::make_unique<DummyDroneAdapter>(
              clock, options.is_null() ? DummyOptions{} : DummyOptions::from_json(options));
+       }},
+      {"airsim",
+       [](const contracts::Clock& clock, const nlohmann::json& options) {
+         return std::make_unique<AirSimAdapter>(clock, AirSimOptions::from_json(options));
+       }},
+      {"tello",
+       [](const contracts::Clock& clock, const nlohmann::json& options) {
+         return std::make_unique<TelloAdapter>(clock, TelloOptions::from_json(options));
        }},
   };
   return kEntries;

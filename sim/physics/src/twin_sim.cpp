@@ -261,6 +261,8 @@ CommandResult TwinSim::rc(int a, int b, int c, int d) {
   return refuse("unknown mode");
 }
 
+void TwinSim::keep_alive() { last_command_s_ = time_s(); }
+
 CommandResult TwinSim::hover() {
   return rc(0, 0, 0, 0);
 }

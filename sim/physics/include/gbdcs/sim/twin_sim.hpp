@@ -103,6 +103,9 @@ class TwinSim {
   CommandResult emergency();
   CommandResult rc(int a, int b, int c, int d);
   CommandResult hover();
+  // Any other command a drone hears (a protocol's handshake, queries, settings): it only
+  // resets the no-command timer, as a real Tello's 15 s auto-land counts every command.
+  void keep_alive();
 
   TwinStatus status() const;
   TwinMode mode() const { return mode_; }

@@ -1,0 +1,148 @@
+// `gbdcs twin --tello [--tello-port 8889]`: the MuJoCo twin in real time, answering the Tello
+// SDK on UDP (and, as they land, AirSim's RPC and the XFly profile) on loopback by default,
+// so the real adapters and any third-party client can fly it. Runs until Ctrl-C or
+// --duration; one status line per second on stderr.
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cmath>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <thread>
+
+#include "commands.hpp"
+#include "gbdcs/sim/airsim_emulator.hpp"
+#include "gbdcs/sim/tello_emulator.hpp"
+#include "gbdcs/sim/twin_host.hpp"
+#include "twin_emulators.hpp"
+
+namespace gbdcs::app {
+namespace {
+
+struct EmulatorCmdOptions {
+  bool tello = false;
+  int tello_port = 8889;
+  int tello_state_port = 8890;
+  std::string tello_sdk = "2.0";
+  bool airsim = false;
+  int airsim_port = 41451;
+  std::string airsim_vehicle = "Drone1";
+  std::string bind = "127.0.0.1";
+  double duration_s = 0;
+  unsigned seed = 1;
+  std::string faults;
+};
+
+EmulatorCmdOptions g_options;
+std::atomic<bool> g_stop{false};
+
+extern "C" void on_signal(int) { g_stop = true; }
+
+}  // namespace
+
+void add_twin_emulator_options(CLI::App* twin) {
+  auto& o = g_options;
+  twin->add_flag("--tello", o.tello,
+                 "Serve the twin as a Tello (SDK 2.0 over UDP) in real time instead of flying "
+                 "a script (docs/ADAPTERS.md)");
+  twin->add_option("--tello-port", o.tello_port, "UDP port of the Tello commands (0: any)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 65535));
+  twin->add_option("--tello-state-port", o.tello_state_port,
+                   "The client's UDP port the Tello state goes to")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 65535));
+  twin->add_option("--tello-sdk", o.tello_sdk, "Tello SDK the emulator speaks")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"2.0", "1.3"}));
+  twin->add_flag("--airsim", o.airsim,
+                 "Serve the twin as an AirSim multirotor (msgpack-RPC over TCP) in real time");
+  twin->add_option("--airsim-port", o.airsim_port, "TCP port of the AirSim RPC (0: any)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 65535));
+  twin->add_option("--airsim-vehicle", o.airsim_vehicle,
+                   "Vehicle name the AirSim emulator answers to (besides \"\")")
+      ->capture_default_str();
+  twin->add_option("--bind", o.bind,
+                   "Address the emulators listen on (loopback by default; 0.0.0.0 to let "
+                   "another machine fly the twin)")
+      ->capture_default_str();
+  twin->add_option("--duration", o.duration_s,
+                   "With an emulator: stop after this many seconds (0: until Ctrl-C)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 86400.0));
+  twin->add_option("--faults", o.faults,
+                   "With an emulator: a fault schedule JSON file (docs/TWIN.md; link_loss drops "
+                   "the protocol traffic)");
+}
+
+bool twin_emulators_requested() { return g_options.tello || g_options.airsim; }
+
+int run_twin_emulators() {
+  const auto& o = g_options;
+  contracts::SteadyClock clock;
+  sim::TwinHostOptions host_options;
+  host_options.seed = o.seed;
+  if (!o.faults.empty()) host_options.twin.faults = sim::FaultSchedule::load(o.faults);
+  sim::TwinHost host(clock, std::make_shared<const sim::TwinModel>(), host_options);
+
+  std::optional<sim::TelloEmulator> tello;
+  if (o.tello) {
+    sim::TelloEmulatorOptions t;
+    t.bind_address = o.bind;
+    t.command_port = o.tello_port;
+    t.state_port = o.tello_state_port;
+    t.sdk = o.tello_sdk;
+    tello.emplace(host, t);
+    std::cerr << "gbdcs twin: Tello SDK " << o.tello_sdk << " on udp://" << o.bind << ":"
+              << tello->port() << " (state to the client's port " << o.tello_state_port
+              << ")\n";
+  }
+  std::optional<sim::AirSimEmulator> airsim;
+  if (o.airsim) {
+    sim::AirSimEmulatorOptions a;
+    a.bind_address = o.bind;
+    a.port = o.airsim_port;
+    a.vehicle = o.airsim_vehicle;
+    airsim.emplace(host, a);
+    std::cerr << "gbdcs twin: AirSim RPC on tcp://" << o.bind << ":" << airsim->port()
+              << " (vehicle \"" << o.airsim_vehicle << "\" or \"\")\n";
+  }
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+  host.start();
+  const auto start = std::chrono::steady_clock::now();
+  auto next_status = start;
+  while (!g_stop) {
+    const auto now = std::chrono::steady_clock::now();
+    if (o.duration_s > 0 && now - start >= std::chrono::duration<double>(o.duration_s)) break;
+    if (now >= next_status) {
+      next_status += std::chrono::seconds(1);
+      const auto s = host.with_sim([](sim::TwinSim& sim) { return sim.status(); });
+      std::cerr << "gbdcs twin: t=" << std::fixed << std::setprecision(1) << s.time_s << " s "
+                << sim::to_string(s.mode) << " alt " << std::setprecision(2) << s.z_m
+                << " m, heading " << std::setprecision(0) << s.heading_deg << " deg, battery "
+                << std::setprecision(1) << s.battery_pct << " %";
+      if (tello) {
+        const auto st = tello->stats();
+        std::cerr << "; tello " << st.datagrams << " datagrams, " << st.state_packets
+                  << " states";
+      }
+      if (airsim) {
+        const auto st = airsim->stats();
+        std::cerr << "; airsim " << st.connections << " connections, " << st.requests
+                  << " requests";
+      }
+      std::cerr << "\n";
+      std::cerr.unsetf(std::ios::fixed);
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  host.stop();
+  std::cerr << "gbdcs twin: stopped\n";
+  return 0;
+}
+
+}  // namespace gbdcs::app
