@@ -1,0 +1,85 @@
+// The runner's private pieces: the camera a scenario shows, the drone it flies, and the
+// artifacts written for a run.
+#pragma once
+
+#include <memory>
+#include <opencv2/core/mat.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "gbdcs/contracts/clock.hpp"
+#include "gbdcs/control/drone_adapter.hpp"
+#include "gbdcs/sim/scenario.hpp"
+#include "gbdcs/sim/scenario_criteria.hpp"
+#include "gbdcs/sim/twin_model.hpp"
+
+namespace gbdcs::sim::detail {
+
+struct CameraFrame {
+  std::optional<contracts::Landmarks> hand;  // what the vision stages found (nullopt: none)
+  std::string label;                         // ground truth of the frame
+  cv::Mat image;                             // the pixels, when the camera has them (BGR)
+};
+
+// A scenario's camera: frame i is shown at i / fps; after its last labelled segment it keeps
+// running with no hand in view (the operator has put the hand down), so vision stays alive.
+class ScenarioCamera {
+ public:
+  virtual ~ScenarioCamera() = default;
+  virtual double fps() const = 0;
+  virtual CameraFrame next() = 0;
+  virtual std::vector<LabelledSegment> segments() const = 0;  // frames_shown left 0
+  virtual std::string describe() const = 0;
+};
+
+std::unique_ptr<ScenarioCamera> open_scenario_camera(const CameraSpec& spec,
+                                                     const contracts::Clock& clock);
+
+// The drone of a scenario and the faults it can take.
+class ScenarioDrone {
+ public:
+  virtual ~ScenarioDrone() = default;
+  virtual control::DroneAdapter& adapter() = 0;
+  // Runner-applied events (the dummy's link loss, battery): start at at_s, end after duration.
+  virtual void on_event(const ScenarioEvent& event, bool starting) = 0;
+  virtual std::optional<int> collisions() const = 0;
+  // The free joint's qpos (x y z qw qx qy qz, MuJoCo frame) for the video; empty when the
+  // drone has no physics (the runner places the model from telemetry instead).
+  virtual std::vector<double> pose_qpos() const = 0;
+  virtual std::string describe() const = 0;
+};
+
+// Throws std::invalid_argument when the drone cannot take one of the scenario's events.
+std::unique_ptr<ScenarioDrone> make_scenario_drone(const Scenario& scenario,
+                                                   const contracts::Clock& clock,
+                                                   std::shared_ptr<const TwinModel> model);
+
+// The twin's model, loaded once per process and shared read-only.
+std::shared_ptr<const TwinModel> shared_twin_model();
+
+struct VideoSnapshot {
+  double t_s = 0;
+  std::vector<double> qpos;  // the free joint, or empty (placed from telemetry)
+  std::optional<contracts::TelemetryFrame> telemetry;
+  std::optional<contracts::Landmarks> hand;
+  std::string label;
+  std::vector<unsigned char> jpeg;  // the camera's frame, when it has pixels
+  std::string last_command;
+  std::string last_alert;
+  bool vision_down = false;
+};
+
+struct LoggedEvent {
+  double t_s = 0;
+  std::string description;
+};
+
+// events.jsonl, trajectory.png and video.mp4 into `dir`; returns the files written.
+std::vector<std::string> write_artifacts(const std::string& dir, const Scenario& scenario,
+                                         const RunRecord& record,
+                                         const std::vector<LoggedEvent>& events,
+                                         const std::vector<VideoSnapshot>& video,
+                                         double video_fps, const TwinModel& model);
+
+}  // namespace gbdcs::sim::detail
