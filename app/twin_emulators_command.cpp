@@ -7,7 +7,9 @@
 #include <csignal>
 #include <cmath>
 #include <iomanip>
+#include <fstream>
 #include <iostream>
+#include <nlohmann/json.hpp>
 #include <memory>
 #include <optional>
 #include <thread>
@@ -29,6 +31,10 @@ struct EmulatorCmdOptions {
   bool airsim = false;
   int airsim_port = 41451;
   std::string airsim_vehicle = "Drone1";
+  bool xfly = false;
+  int xfly_port = 9889;
+  int xfly_state_port = 9890;
+  std::string xfly_profile;
   std::string bind = "127.0.0.1";
   double duration_s = 0;
   unsigned seed = 1;
@@ -65,6 +71,18 @@ void add_twin_emulator_options(CLI::App* twin) {
   twin->add_option("--airsim-vehicle", o.airsim_vehicle,
                    "Vehicle name the AirSim emulator answers to (besides \"\")")
       ->capture_default_str();
+  twin->add_flag("--xfly", o.xfly,
+                 "Serve the twin as an XFly (the assumed Tello-style text-over-UDP profile)");
+  twin->add_option("--xfly-port", o.xfly_port, "UDP port of the XFly commands (0: any)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 65535));
+  twin->add_option("--xfly-state-port", o.xfly_state_port,
+                   "The client's UDP port the XFly state goes to")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 65535));
+  twin->add_option("--xfly-profile", o.xfly_profile,
+                   "JSON file {\"commands\": {takeoff, land, ...}} renaming the XFly's command "
+                   "words (docs/ADAPTERS.md)");
   twin->add_option("--bind", o.bind,
                    "Address the emulators listen on (loopback by default; 0.0.0.0 to let "
                    "another machine fly the twin)")
@@ -78,7 +96,7 @@ void add_twin_emulator_options(CLI::App* twin) {
                    "the protocol traffic)");
 }
 
-bool twin_emulators_requested() { return g_options.tello || g_options.airsim; }
+bool twin_emulators_requested() { return g_options.tello || g_options.airsim || g_options.xfly; }
 
 int run_twin_emulators() {
   const auto& o = g_options;
@@ -109,6 +127,27 @@ int run_twin_emulators() {
     airsim.emplace(host, a);
     std::cerr << "gbdcs twin: AirSim RPC on tcp://" << o.bind << ":" << airsim->port()
               << " (vehicle \"" << o.airsim_vehicle << "\" or \"\")\n";
+  }
+  std::optional<sim::TelloEmulator> xfly;
+  if (o.xfly) {
+    nlohmann::json profile = nlohmann::json::object();
+    if (!o.xfly_profile.empty()) {
+      std::ifstream in(o.xfly_profile);
+      if (!in) throw std::invalid_argument("--xfly-profile: cannot read " + o.xfly_profile);
+      profile = nlohmann::json::parse(in, nullptr, false);
+      if (profile.is_discarded() || !profile.is_object()) {
+        throw std::invalid_argument("--xfly-profile " + o.xfly_profile +
+                                    ": not a JSON object like {\"commands\": {...}}");
+      }
+    }
+    profile["bind_address"] = o.bind;
+    profile["command_port"] = o.xfly_port;
+    profile["state_port"] = o.xfly_state_port;
+    auto x = sim::TelloEmulatorOptions::from_json(profile);
+    x.label = "xfly";
+    xfly.emplace(host, x);
+    std::cerr << "gbdcs twin: XFly profile on udp://" << o.bind << ":" << xfly->port()
+              << " (state to the client's port " << o.xfly_state_port << ")\n";
   }
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);

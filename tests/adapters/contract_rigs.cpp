@@ -5,6 +5,7 @@
 #include "gbdcs/adapters/airsim_adapter.hpp"
 #include "gbdcs/adapters/dummy_adapter.hpp"
 #include "gbdcs/adapters/tello_adapter.hpp"
+#include "gbdcs/adapters/xfly_profile.hpp"
 #include "gbdcs/sim/airsim_emulator.hpp"
 #include "gbdcs/sim/tello_emulator.hpp"
 #include "gbdcs/sim/twin_adapter.hpp"
@@ -153,12 +154,29 @@ std::unique_ptr<Rig> make_rig(const std::string& name) {
     return std::make_unique<TelloRig>(nlohmann::json::object(), emulator, TelloOptions{});
   }
   if (name == "airsim") return std::make_unique<AirSimRig>();
+  if (name == "xfly") {
+    // The XFly profile with its command words renamed on both sides: the profile is config.
+    const nlohmann::json words = {{"handshake", "sdk_on"}, {"takeoff", "launch"},
+                                  {"land", "descend"},     {"emergency", "kill"},
+                                  {"stop", "halt"},        {"rc", "sticks"},
+                                  {"keepalive", "sdk_on"}, {"battery", "bat?"}};
+    sim::TelloEmulatorOptions emulator = sim::TelloEmulatorOptions::from_json(
+        {{"command_port", 0}, {"commands", words}});
+    emulator.label = "xfly";
+    const XflyProfile profile;
+    TelloOptions defaults;
+    defaults.name = profile.name;
+    defaults.drone_label = profile.label;
+    defaults.wifi_hint = profile.wifi_hint;
+    return std::make_unique<TelloRig>(xfly_engine_options({{"commands", words}}, profile),
+                                      emulator, defaults);
+  }
   throw std::invalid_argument("no rig named " + name);
 }
 
 std::vector<RigCase> all_rigs() {
   std::vector<RigCase> out;
-  for (const char* n : {"dummy", "twin", "tello", "airsim"}) {
+  for (const char* n : {"dummy", "twin", "tello", "airsim", "xfly"}) {
     out.push_back({n, [name = std::string(n)] { return make_rig(name); }});
   }
   return out;

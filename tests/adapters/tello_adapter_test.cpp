@@ -232,3 +232,30 @@ TEST(TelloAdapter, OptionsAreStrictAndNameTheKey) {
 
 }  // namespace
 }  // namespace gbdcs::adapters::testing
+
+#include "gbdcs/adapters/registry.hpp"
+
+namespace gbdcs::adapters::testing {
+namespace {
+
+TEST(Registry, XflyIsTheTelloEngineWithItsAssumedProfile) {
+  contracts::ManualClock clock;
+  auto xfly = make_adapter("xfly", clock,
+                           {{"state_port", 0}, {"reply_timeout_ms", 20}, {"handshake_retries", 1}});
+  EXPECT_EQ(xfly->name(), "xfly");
+  EXPECT_NE(xfly->connect(), control::Result::kOk);  // nobody at 192.168.4.1 here
+  EXPECT_NE(xfly->last_error().find("192.168.4.1"), std::string::npos) << xfly->last_error();
+  try {
+    make_adapter("xfly", clock, {{"colour", "red"}});
+    ADD_FAILURE() << "accepted an unknown option";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("xfly options: 'colour'"), std::string::npos) << e.what();
+  }
+  const auto names = adapter_names();
+  for (const char* n : {"dummy", "airsim", "tello", "xfly"}) {
+    EXPECT_NE(std::find(names.begin(), names.end(), n), names.end()) << n;
+  }
+}
+
+}  // namespace
+}  // namespace gbdcs::adapters::testing

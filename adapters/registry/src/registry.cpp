@@ -7,6 +7,7 @@
 #include "gbdcs/adapters/airsim_adapter.hpp"
 #include "gbdcs/adapters/dummy_adapter.hpp"
 #include "gbdcs/adapters/tello_adapter.hpp"
+#include "gbdcs/adapters/xfly_profile.hpp"
 
 namespace gbdcs::adapters {
 namespace {
@@ -28,6 +29,17 @@ const std::vector<std::pair<std::string, Maker>>& entries() {
       {"tello",
        [](const contracts::Clock& clock, const nlohmann::json& options) {
          return std::make_unique<TelloAdapter>(clock, TelloOptions::from_json(options));
+       }},
+      {"xfly",
+       [](const contracts::Clock& clock, const nlohmann::json& options) {
+         // XFly: the Tello engine with the XFly profile (adapters/xfly, docs/ADAPTERS.md).
+         const XflyProfile profile;
+         TelloOptions defaults;
+         defaults.name = profile.name;
+         defaults.drone_label = profile.label;
+         defaults.wifi_hint = profile.wifi_hint;
+         return std::make_unique<TelloAdapter>(
+             clock, TelloOptions::from_json(xfly_engine_options(options, profile), defaults));
        }},
   };
   return kEntries;
