@@ -9,7 +9,9 @@
 #include <string_view>
 
 #include "gbdcs/contracts/clock.hpp"
+#include "gbdcs/storage/records.hpp"
 #include "gbdcs/storage/storage_options.hpp"
+#include "sqlite_connection.hpp"
 
 namespace gbdcs::storage::detail {
 
@@ -49,6 +51,18 @@ auto locked_read(std::mutex& mutex, const std::string& path, std::string_view wh
   } catch (const std::exception& e) {
     throw StorageError("cannot read " + std::string(what) + " from " + path + ": " + e.what());
   }
+}
+
+// A users row selected as `id, username, password_hash, theme, created_at_ms`.
+
+inline UserRecord user_from_row(Query& q) {
+  UserRecord u;
+  u.id = q->int64(0);
+  u.username = q->text(1);
+  u.password_hash = q->text(2);
+  u.theme = q->text(3);
+  u.created_at = from_ms(q->int64(4));
+  return u;
 }
 
 }  // namespace gbdcs::storage::detail

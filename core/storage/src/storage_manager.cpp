@@ -201,13 +201,7 @@ std::optional<UserRecord> StorageManager::find_user(std::string_view username) c
         "SELECT id, username, password_hash, theme, created_at_ms FROM users WHERE username = ?1");
     q->bind(1, username);
     if (!q->step()) return std::nullopt;
-    UserRecord u;
-    u.id = q->int64(0);
-    u.username = q->text(1);
-    u.password_hash = q->text(2);
-    u.theme = q->text(3);
-    u.created_at = from_ms(q->int64(4));
-    return u;
+    return detail::user_from_row(q);
   });
 }
 

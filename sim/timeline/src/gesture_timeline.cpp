@@ -1,8 +1,8 @@
 #include "gbdcs/sim/gesture_timeline.hpp"
 
 #include <cmath>
-#include <fstream>
-#include <sstream>
+
+#include "gbdcs/contracts/json_file.hpp"
 
 namespace gbdcs::sim {
 
@@ -109,21 +109,8 @@ GestureTimeline GestureTimeline::from_json(const nlohmann::json& doc) {
 }
 
 GestureTimeline GestureTimeline::load_file(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw TimelineError(path + ": cannot read the timeline file (check the path)");
-  std::stringstream text;
-  text << in.rdbuf();
-  nlohmann::json doc;
-  try {
-    doc = nlohmann::json::parse(text.str());
-  } catch (const nlohmann::json::parse_error& e) {
-    throw TimelineError(path + ": malformed JSON at byte " + std::to_string(e.byte));
-  }
-  try {
-    return from_json(doc);
-  } catch (const TimelineError& e) {
-    throw TimelineError(path + ": " + e.what());
-  }
+  const auto doc = contracts::read_json_file<TimelineError>(path, "timeline file");
+  return contracts::prefix_errors<TimelineError>(path, [&] { return from_json(doc); });
 }
 
 double GestureTimeline::duration_s() const {

@@ -2,11 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <limits>
 #include <optional>
 #include <sstream>
 
+#include "gbdcs/contracts/json_file.hpp"
 #include "gbdcs/sim/twin_adapter.hpp"
 
 namespace gbdcs::sim {
@@ -165,21 +165,8 @@ CommandScript CommandScript::from_json(const nlohmann::json& doc) {
 }
 
 CommandScript CommandScript::load_file(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw ScriptError(path + ": cannot read the command script (check the path)");
-  std::stringstream text;
-  text << in.rdbuf();
-  nlohmann::json doc;
-  try {
-    doc = nlohmann::json::parse(text.str());
-  } catch (const nlohmann::json::parse_error& e) {
-    throw ScriptError(path + ": malformed JSON at byte " + std::to_string(e.byte));
-  }
-  try {
-    return from_json(doc);
-  } catch (const ScriptError& e) {
-    throw ScriptError(path + ": " + e.what());
-  }
+  const auto doc = contracts::read_json_file<ScriptError>(path, "command script");
+  return contracts::prefix_errors<ScriptError>(path, [&] { return from_json(doc); });
 }
 
 CommandScript CommandScript::builtin_demo() {
