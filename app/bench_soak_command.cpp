@@ -47,6 +47,7 @@ struct SoakOptions {
   double warmup_s = 30;
   double sample_every_s = 5;
   double rss_growth_limit_mb = 64;
+  double drain_timeout_s = 120;
   int token_ttl_s = 1800;
   std::string keep_dir;
   bool json_out = false;
@@ -200,13 +201,8 @@ int run_soak(const SoakOptions& o) {
   }
   const std::int64_t t1_ms = soak::now_utc_ms();
   const double window_s = std::chrono::duration<double>(Steady::now() - window_start).count();
-  // Let the last alerts reach every client before they stop reading.
-  std::this_thread::sleep_for(std::chrono::seconds(3));
-  const auto metrics = soak::http_call(port, "GET", "/api/v1/metrics", {}, probe_token);
-  const auto health = soak::http_call(port, "GET", "/api/v1/healthz");
-  const auto load_end = load_average();
-  stop_clients = true;
-
+  // The alerts of the window, as the server logged them (the log line follows the broadcast).
+  std::this_thread::sleep_for(std::chrono::seconds(1));
   std::set<std::string> sent;
   {
     std::lock_guard lock(alerts_mutex);
@@ -214,8 +210,24 @@ int run_soak(const SoakOptions& o) {
       if (ts >= t0_ms && ts <= t1_ms) sent.insert(alert);
     }
   }
+  // A slow client is sent its alerts late, never not at all: wait until every client has every
+  // one (or --drain-timeout passes; what is still missing then counts as dropped).
+  const auto drain_start = Steady::now();
+  const auto drain_until = drain_start + std::chrono::duration_cast<Steady::duration>(
+                                             std::chrono::duration<double>(o.drain_timeout_s));
+  for (;;) {
+    std::size_t missing = 0;
+    for (auto& c : clients) missing += c->missing(sent);
+    if (missing == 0 || Steady::now() >= drain_until) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(250));
+  }
+  const double drain_s = std::chrono::duration<double>(Steady::now() - drain_start).count();
+  const auto metrics = soak::http_call(port, "GET", "/api/v1/metrics", {}, probe_token);
+  const auto health = soak::http_call(port, "GET", "/api/v1/healthz");
+  const auto load_end = load_average();
+  stop_clients = true;
   std::int64_t received = 0, dropped = 0, unexpected_closes = 0, renewals = 0, messages = 0;
-  std::vector<double> delivery, frame_age, command_age;
+  std::vector<double> delivery, frame_age, command_age, alert_age;
   std::string client_error;
   for (auto& c : clients) {
     auto r = c->report();
@@ -229,6 +241,7 @@ int run_soak(const SoakOptions& o) {
     delivery.insert(delivery.end(), r.delivery_ms.begin(), r.delivery_ms.end());
     frame_age.insert(frame_age.end(), r.frame_age_ms.begin(), r.frame_age_ms.end());
     command_age.insert(command_age.end(), r.command_age_ms.begin(), r.command_age_ms.end());
+    alert_age.insert(alert_age.end(), r.alert_age_ms.begin(), r.alert_age_ms.end());
     if (r.unexpected_closes > 0 && client_error.empty()) client_error = r.last_error;
   }
   clients.clear();
@@ -262,6 +275,9 @@ int run_soak(const SoakOptions& o) {
               {"alerts_expected", static_cast<std::int64_t>(sent.size()) * o.clients},
               {"alerts_received", received},
               {"alerts_dropped", dropped},
+              {"alert_age_ms_p99", soak::percentile(alert_age, 0.99)},
+              {"alert_age_ms_max", alert_age.empty() ? 0.0 : *std::max_element(alert_age.begin(), alert_age.end())},
+              {"alerts_drain_s", drain_s},
               {"messages_received", messages},
               {"ws_dropped", metric_value(metrics.body, "gbdcs_ws_dropped_total")},
               {"ws_broadcasts", metric_value(metrics.body, "gbdcs_ws_broadcasts_total")},
@@ -338,6 +354,10 @@ void add_bench_soak(CLI::App& app) {
   cmd->add_option("--rss-growth-limit-mb", o.rss_growth_limit_mb,
                   "Fail when the server's RSS grows more than this over the window")
       ->capture_default_str();
+  cmd->add_option("--drain-timeout", o.drain_timeout_s,
+                  "After the window, seconds to wait for every client to get every alert")
+      ->capture_default_str()
+      ->check(CLI::Range(1.0, 3600.0));
   cmd->add_option("--token-ttl", o.token_ttl_s, "GBDCS_TOKEN_TTL_S for the server (60-1800)")
       ->capture_default_str()
       ->check(CLI::Range(60, 1800));

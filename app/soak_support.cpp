@@ -243,6 +243,13 @@ bool SoakClient::wait_connected(std::chrono::seconds timeout) {
   return connected_;
 }
 
+std::size_t SoakClient::missing(const std::set<std::string>& alerts) const {
+  std::lock_guard lock(alerts_mutex_);
+  std::size_t n = 0;
+  for (const auto& a : alerts) n += report_.alerts.count(a) ? 0 : 1;
+  return n;
+}
+
 ClientReport SoakClient::report() {
   if (thread_.joinable()) thread_.join();
   return report_;
@@ -268,7 +275,13 @@ void SoakClient::run() {
     const auto type = doc.value("type", "");
     ++report_.messages[type];
     const auto& data = doc["data"];
-    if (type == "alert") report_.alerts.insert(data.dump());
+    if (type == "alert") {
+      std::lock_guard lock(alerts_mutex_);
+      report_.alerts.insert(data.dump());
+      if (data.is_object()) {
+        if (auto ts = utc_ms(data.value("timestamp", "")); ts > 0) report_.alert_age_ms.push_back(double(received - ts));
+      }
+    }
     if (!measure || !data.is_object()) return doc;
     if (type == "telemetry") {
       if (auto ts = utc_ms(doc.value("ts", "")); ts > 0) report_.delivery_ms.push_back(double(received - ts));

@@ -81,6 +81,7 @@ struct ClientReport {
   std::vector<double> delivery_ms;               // telemetry: receive - envelope ts
   std::vector<double> frame_age_ms;              // frame: receive - capture_time
   std::vector<double> command_age_ms;            // command: receive - command.issued_at
+  std::vector<double> alert_age_ms;              // alert: receive - alert.timestamp
   std::set<std::string> alerts;                  // each alert's data, dumped (its identity)
   std::int64_t renewals = 0;
   std::int64_t unexpected_closes = 0;
@@ -95,6 +96,8 @@ class SoakClient {
              const std::atomic<bool>& stop);
   ~SoakClient();
   bool wait_connected(std::chrono::seconds timeout);
+  // How many of `alerts` (dumped alert data) this client has not received yet.
+  std::size_t missing(const std::set<std::string>& alerts) const;
   ClientReport report();  // after stop: joins the thread
 
  private:
@@ -104,6 +107,7 @@ class SoakClient {
   double renew_fraction_;
   const std::atomic<bool>& stop_;
   std::atomic<bool> connected_{false};
+  mutable std::mutex alerts_mutex_;  // guards report_.alerts while running
   ClientReport report_;
   std::thread thread_;
 };
