@@ -8,7 +8,9 @@
 //          on_vision_frame(msg)     a vision_frame message from the worker
 //          on_vision_health(ok, why), raise_alert(alert)
 //          emergency_stop / reset_emergency / key(key, pressed) / submit(command)
-// Outputs: hub messages gesture, command, alert, telemetry, state (every 1 s and on change);
+// Outputs: hub messages gesture, command, alert, telemetry, state (every 1 s and on change),
+//          drone_view (the adapter's picture, e.g. the twin's chase camera, at options.view.fps
+//          while a client is connected);
 //          the log callback gets one JSON object per command and safety event.
 // Time   : the injected Clock; a tick thread calls ControlLoop::tick every tick_s.
 #pragma once
@@ -40,6 +42,8 @@ struct DroneServiceOptions {
   double tick_s = 0.02;
   double state_every_s = 1.0;
   runtime::ControlLoopOptions loop;
+  // The drone's own picture (DroneAdapter::start_view) as drone_view messages; fps 0: off.
+  control::ViewOptions view;
 };
 
 struct VisionStatus {
