@@ -128,6 +128,7 @@ export function AlertBanners({ alerts, onAck, onDismiss }: AlertProps) {
           role={a.alert.severity === 'INFO' ? 'status' : 'alert'}
           data-testid="alert"
           data-code={a.alert.code}
+          data-alert-id={a.alert.id}
         >
           <div className="alert-text">
             <strong>

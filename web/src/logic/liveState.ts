@@ -1,6 +1,7 @@
 // The flying view's state, built from /ws/live messages by one pure reducer. The live socket
 // and the replay player both feed it, so the panels are the same whether live or replayed.
-// Camera frames do not pass through here (they go straight to the feed canvas at 24+ FPS).
+// Camera frames and drone views do not pass through here (they go straight to the feed canvas
+// and the drone-view image).
 import type {
   Alert,
   GestureEvent,
@@ -149,6 +150,7 @@ function onMessage(state: LiveState, msg: WsServerMessage, nowMs: number): LiveS
     case 'error':
       return { ...base, lastError: msg.data };
     case 'frame':
+    case 'drone_view':
       return base;
   }
 }
