@@ -107,21 +107,5 @@ TEST(TwinView, BadOptionsAreRefusedWithTheReason) {
   EXPECT_EQ(rig.twin.start_view(o, nullptr), Result::kRejected);
 }
 
-TEST(TwinView, AnAdapterWithoutACameraSaysUnsupported) {
-  struct NoCamera final : control::DroneAdapter {
-    std::string_view name() const override { return "none"; }
-    Result connect() override { return Result::kOk; }
-    Result disconnect() override { return Result::kOk; }
-    Result takeoff() override { return Result::kOk; }
-    Result land() override { return Result::kOk; }
-    Result hover() override { return Result::kOk; }
-    Result move(const contracts::MotionPayload&) override { return Result::kOk; }
-    Result emergency_stop() override { return Result::kOk; }
-    contracts::FlightState state() const override { return contracts::FlightState::kReady; }
-    void set_telemetry_sink(control::TelemetrySink) override {}
-  } none;
-  EXPECT_EQ(none.start_view({}, [](const control::DroneView&) {}), Result::kUnsupported);
-}
-
 }  // namespace
 }  // namespace gbdcs::sim

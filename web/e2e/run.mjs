@@ -301,7 +301,10 @@ async function main() {
     // 6. Emergency stop (Space) brings it down.
     await page.locator('body').press('Space');
     await waitText('flight-state', (t) => t !== 'FLYING', 'still FLYING after the emergency stop');
-    await page.getByText('Emergency stop is latched').waitFor({ timeout: STEP_MS });
+    await page
+      .getByRole('alert')
+      .filter({ hasText: 'Emergency stop is latched' })
+      .waitFor({ timeout: STEP_MS });
     await waitText(
       'altitude',
       (t) => parseFloat(t) < 0.2,

@@ -468,7 +468,7 @@ export type WsDroneViewData = {
   jpeg: string;
 };
 
-/** The drone seen by its adapter's camera (the twin's chase camera); only from drones that have one (DroneAdapter::start_view).
+/** The drone seen by its adapter's camera (the twin's chase camera); only from drones that have one (control::DroneViewSource).
  * Schema: core/contracts/schemas/ws_drone_view_message.schema.json */
 export type WsDroneViewMessage = {
   type: "drone_view";

@@ -6,17 +6,11 @@
 //          while connected; state() the current FlightState.
 // Threading: calls may come from any thread; an adapter serialises them itself. The sink
 //          may be called from the adapter's own thread or from poll().
-// View (optional capability): start_view() asks the drone for a live picture (the twin's
-//          chase camera; a real drone's video where an adapter can decode it): JPEG images
-//          of about options.width x options.height at about options.fps, pushed to the sink
-//          from the adapter's own thread until stop_view() (which returns once the sink is no
-//          longer called) or disconnect. Default: kUnsupported, no picture.
 // poll(): adapters driven by a host loop (the dummy, the twin in lockstep) advance their
 //          simulation to the injected clock's now and emit telemetry there; adapters with
 //          their own I/O threads may leave it empty.
 #pragma once
 
-#include <cstdint>
 #include <functional>
 #include <memory>
 #include <string>
@@ -38,21 +32,6 @@ std::string_view to_string(Result r);
 
 using TelemetrySink = std::function<void(const contracts::TelemetryFrame&)>;
 
-struct ViewOptions {
-  int width = 320;
-  int height = 240;
-  double fps = 5;
-  int jpeg_quality = 70;  // 1...100
-};
-struct DroneView {
-  std::string jpeg;    // the encoded image (bytes)
-  int width = 0;       // px
-  int height = 0;      // px
-  std::string camera;  // e.g. "chase"
-  std::int64_t frame_id = 0;
-};
-using ViewSink = std::function<void(const DroneView&)>;
-
 class DroneAdapter {
  public:
   virtual ~DroneAdapter() = default;
@@ -70,11 +49,6 @@ class DroneAdapter {
   virtual void set_telemetry_sink(TelemetrySink sink) = 0;
   virtual void poll() {}
   virtual std::string last_error() const { return {}; }
-
-  virtual Result start_view(const ViewOptions& /*options*/, ViewSink /*sink*/) {
-    return Result::kUnsupported;
-  }
-  virtual void stop_view() {}
 };
 
 // Sends one command to the adapter (MOVE without payload is kRejected).

@@ -28,6 +28,7 @@
 #include "gbdcs/contracts/clock.hpp"
 #include "gbdcs/control/command_translator.hpp"
 #include "gbdcs/control/drone_adapter.hpp"
+#include "gbdcs/control/drone_view.hpp"
 #include "gbdcs/runtime/control_loop.hpp"
 #include "gbdcs/server/live_hub.hpp"
 #include "gbdcs/storage/storage_manager.hpp"
@@ -42,7 +43,7 @@ struct DroneServiceOptions {
   double tick_s = 0.02;
   double state_every_s = 1.0;
   runtime::ControlLoopOptions loop;
-  // The drone's own picture (DroneAdapter::start_view) as drone_view messages; fps 0: off.
+  // The drone's own picture (control::DroneViewSource) as drone_view messages; fps 0: off.
   control::ViewOptions view;
 };
 

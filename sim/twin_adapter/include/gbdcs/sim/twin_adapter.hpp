@@ -28,8 +28,8 @@
 //          realtime_step_hz 200 (10...2000), seed 1, model "" (TwinModel::default_model_path()),
 //          twin {} (TwinOptions::from_json: controller, battery, crash_speed_m_s,
 //          auto_land_after_s, faults).
-// View   : start_view() renders the twin's "chase" camera (sim/render, OSMesa on the CPU) on
-//          a thread of its own at options.fps (wall time; 0 < fps <= 30, 16...1920 x
+// View   : control::DroneViewSource: start_view() renders the twin's "chase" camera
+//          (sim/render, OSMesa on the CPU) on a thread of its own at options.fps (wall time; 0 < fps <= 30, 16...1920 x
 //          16...1080 px), from a copy of the state taken under the lock between steps, JPEG
 //          encoded, to the sink; stop_view(), disconnect() and the destructor end it. A
 //          renderer that cannot start (no OSMesa) ends the view with last_error() set.
@@ -51,6 +51,7 @@
 
 #include "gbdcs/contracts/clock.hpp"
 #include "gbdcs/control/drone_adapter.hpp"
+#include "gbdcs/control/drone_view.hpp"
 #include "gbdcs/sim/twin_sim.hpp"
 
 namespace gbdcs::sim {
@@ -73,7 +74,7 @@ std::array<int, 4> motion_to_rc(const contracts::MotionPayload& motion,
 
 contracts::FlightState flight_state_of(TwinMode mode);
 
-class TwinAdapter final : public control::DroneAdapter {
+class TwinAdapter final : public control::DroneAdapter, public control::DroneViewSource {
  public:
   TwinAdapter(const contracts::Clock& clock, TwinAdapterOptions options = {});
   // Shares an already loaded model (tests, several twins); options.model_path is ignored.
