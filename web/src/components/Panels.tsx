@@ -133,6 +133,7 @@ export function AlertBanners({ alerts, onAck, onDismiss }: AlertProps) {
           <div className="alert-text">
             <strong>
               {a.alert.severity} · {a.alert.code}
+              {a.count && a.count > 1 ? ` (×${a.count})` : ''}
             </strong>
             <span className="cause">{a.alert.cause}</span>
             <span className="suggestion">
