@@ -12,6 +12,10 @@
 //          drone_view (the adapter's picture, e.g. the twin's chase camera, at options.view.fps
 //          while a client is connected);
 //          the log callback gets one JSON object per command and safety event.
+//          Storage: when SQLite writes start failing (disk full, ...) the tick thread raises
+//          STORAGE_WRITE_FAILING (WARNING, cause and fix from storage::WriteHealth) and logs
+//          it, repeats the log every 10 s while it lasts, and raises STORAGE_RECOVERED (INFO)
+//          when writes succeed again. Flying is not affected.
 // Time   : the injected Clock; a tick thread calls ControlLoop::tick every tick_s.
 #pragma once
 
@@ -90,7 +94,9 @@ class DroneService {
  private:
   struct Active;
   void tick_loop();
+  void watch_storage();  // on the tick thread, outside every lock
   void stop_active_locked();
+  void end_session_quietly(std::int64_t session);  // never throws
 
   const contracts::Clock& clock_;
   storage::StorageManager& storage_;
@@ -112,6 +118,9 @@ class DroneService {
   std::vector<std::shared_ptr<runtime::EventListener>> extra_listeners_;
   std::string last_state_;
 
+  std::int64_t storage_episodes_seen_ = 0;  // tick thread only
+  bool storage_failing_ = false;
+  contracts::Duration storage_next_log_{};
   std::atomic<bool> running_{true};
   std::thread ticker_;
 };
