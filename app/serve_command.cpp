@@ -38,6 +38,7 @@ struct ServeOptions {
   bool log_json = false;
   bool no_worker = false;
   double worker_silence_s = 2.0;
+  double drone_view_fps = 5.0;  // the twin's chase camera as drone_view messages; 0: off
 };
 
 std::atomic<bool> g_stop{false};
@@ -92,15 +93,21 @@ void apply_config_file(ServeOptions& o, const CLI::App& cmd) {
       else if (key == "source") { if (!given) o.source = value.get<std::string>(); }
       else if (key == "web") { if (!given) o.web = value.get<std::string>(); }
       else if (key == "log-json") { if (!given) o.log_json = value.get<bool>(); }
+      else if (key == "drone-view-fps") { if (!given) o.drone_view_fps = value.get<double>(); }
       else throw std::runtime_error("unknown key");
     } catch (const std::exception& e) {
       throw std::runtime_error("--config " + o.config + ": key '" + key + "': " + e.what() +
-                               " (keys: port, bind, db, adapter, adapter-options, source, web, log-json)");
+                               " (keys: port, bind, db, adapter, adapter-options, source, web, log-json, "
+                               "drone-view-fps)");
     }
   }
 }
 
 int run_serve(ServeOptions o) {
+  if (!(o.drone_view_fps >= 0 && o.drone_view_fps <= 30)) {
+    throw std::runtime_error("drone-view-fps " + std::to_string(o.drone_view_fps) +
+                             " is out of range: give 0 (off) to 30");
+  }
   contracts::SteadyClock clock;
   auto log = server::make_event_log(clock, o.log_json);
   // A file-size limit (ulimit -f) must fail the write (EFBIG, reported like a full disk), not
@@ -150,7 +157,11 @@ int run_serve(ServeOptions o) {
   server::DroneService drone(
       clock, storage, hub,
       [&clock](const std::string& name, const json& options) { return make_drone(name, clock, options); },
-      profile, log);
+      profile, log, [&o] {
+        server::DroneServiceOptions dso;
+        dso.view.fps = o.drone_view_fps;  // 320x240 JPEG: cheap next to vision on 2 cores
+        return dso;
+      }());
 
   const std::string worker_secret = server::TokenService::random_secret();
   server::ServerOptions so2;
@@ -273,6 +284,11 @@ void add_serve_command(CLI::App& app) {
                   "Seconds without a worker message before it is declared lost")
       ->capture_default_str()
       ->check(CLI::Range(0.2, 60.0));
+  cmd->add_option("--drone-view-fps", o.drone_view_fps,
+                  "Pictures per second of the drone from its own camera (the twin's chase camera, "
+                  "320x240 JPEG) sent as drone_view messages; 0: off")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 30.0));
   cmd->callback([cmd] {
     try {
       if (!o.config.empty()) apply_config_file(o, *cmd);

@@ -145,6 +145,10 @@ async function main() {
     const page = await browser.newPage({ viewport: { width: 1366, height: 900 } });
     const errors = [];
     page.on('pageerror', (e) => errors.push(e.message));
+    const sockets = [];
+    page.on('websocket', (ws) => {
+      if (ws.url().includes('/ws/live')) sockets.push(ws);
+    });
     let n = 0;
     const shot = async (name) => {
       const file = join(out, `${String(++n).padStart(2, '0')}-${name}.png`);
@@ -166,6 +170,21 @@ async function main() {
         await page.waitForTimeout(200);
       }
       fail(`${what}: [${testid}] is "${now}"`);
+    };
+
+    const waitAttr = async (testid, name, pred, what) => {
+      const end = Date.now() + STEP_MS;
+      let now = null;
+      while (Date.now() < end) {
+        now = await page
+          .getByTestId(testid)
+          .first()
+          .getAttribute(name, { timeout: 1000 })
+          .catch(() => null);
+        if (now !== null && pred(now)) return now;
+        await page.waitForTimeout(200);
+      }
+      fail(`${what}: [${testid}] ${name}="${now}"`);
     };
 
     // 1. A bad login shows the server's own cause and suggestion.
@@ -205,9 +224,10 @@ async function main() {
     await waitText('feed-fps', (t) => parseFloat(t) > 0, 'the feed shows no frames');
     await shot('telemetry-and-gesture-live');
 
-    // 4. The drone takes off by gesture (the demo hand shows the take-off gesture): the command
-    // log shows TAKEOFF from a gesture accepted, and the telemetry says FLYING (it may have
-    // landed again by the time we look, so either is read as it happens).
+    // 4. The drone takes off by gesture. The camera's hand shows the take-off gesture every
+    // loop, so the drone may already be in the air from before this browser logged in: then the
+    // operator lands it (the Land button) and the next take-off gesture must lift it again. The
+    // command log then shows TAKEOFF from a gesture accepted, and the telemetry says FLYING.
     const tookOff = () =>
       page.evaluate(() =>
         window.__gbdcs.live.commands.some(
@@ -215,10 +235,27 @@ async function main() {
             c.command.type === 'TAKEOFF' && c.command.source === 'gesture' && c.outcome === 'OK',
         ),
       );
+    if ((await text('flight-state')) === 'FLYING' && !(await tookOff())) {
+      log('the drone took off before the login: landing it to see the gesture take off again');
+      await page.getByRole('button', { name: /^Land/ }).click();
+      await waitText('flight-state', (t) => t === 'READY', 'not back on the ground after Land');
+    }
     for (const end = Date.now() + STEP_MS; !(await tookOff()); await page.waitForTimeout(250))
       if (Date.now() > end) fail('no TAKEOFF by gesture was accepted');
-    await waitText('path-map', () => true, 'no path map');
+    await waitText('flight-state', (t) => t === 'FLYING', 'not FLYING after the take-off gesture');
+    // The path map (an SVG: its point count is an attribute) draws the flight since take-off.
+    await waitAttr('path-map', 'data-points', (v) => Number(v) > 1, 'the path map stays empty');
     await shot('took-off-by-gesture');
+
+    // 4b. The twin's chase camera: drone_view pictures reach the flying view.
+    await waitAttr(
+      'drone-view',
+      'data-frame-id',
+      (v) => Number(v) >= 1,
+      'no picture from the twin chase camera',
+    );
+    await page.getByTestId('drone-view').scrollIntoViewIfNeeded();
+    await shot('twin-chase-camera');
 
     // 5. An alert appears and is acknowledged: kill -9 the vision worker (the server's child).
     const kids = execFileSync('ps', ['-o', 'pid=,args=', '--ppid', String(child.pid)]).toString();
@@ -228,36 +265,46 @@ async function main() {
       .find((l) => /\bvision\b/.test(l));
     if (!worker) fail(`no vision worker among gbdcs serve's children:\n${kids}`);
     process.kill(Number(worker.split(/\s+/)[0]), 'SIGKILL');
-    const banner = page
-      .locator(
-        '[data-testid="alert"][data-code="VISION_WORKER_LOST"], [data-testid="alert"].alert-critical',
-      )
-      .first();
-    await banner.waitFor({ timeout: STEP_MS });
+    // The first VISION_WORKER_LOST banner (by its alert id: another one may follow if the
+    // restarted worker is slow), acknowledged from the page, then checked in the stored session.
+    const lost = page.locator('[data-testid="alert"][data-code="VISION_WORKER_LOST"]').first();
+    await lost.waitFor({ timeout: STEP_MS });
+    const alertId = await lost.getAttribute('data-alert-id');
+    const banner = page.locator(`[data-testid="alert"][data-alert-id="${alertId}"]`);
     const alertText = await banner.innerText();
     await shot('alert-shown');
     await banner.getByRole('button', { name: 'Acknowledge' }).click();
     await banner.waitFor({ state: 'detached', timeout: STEP_MS });
-    const acked = await fetch(`${base}/api/v1/sessions?limit=1`, {
-      headers: {
-        Authorization: `Bearer ${await page.evaluate(() => JSON.parse(localStorage.getItem('gbdcs.login')).token)}`,
-      },
-    }).then((r) => r.json());
-    log(`alert "${alertText.split('\n')[0]}" acknowledged; session ${acked.sessions[0]?.id}`);
+    const token = await page.evaluate(() => JSON.parse(localStorage.getItem('gbdcs.login')).token);
+    const auth = { headers: { Authorization: `Bearer ${token}` } };
+    const sessions = await fetch(`${base}/api/v1/sessions?limit=1`, auth).then((r) => r.json());
+    const sessionId = sessions.sessions[0]?.id;
+    const detail = await fetch(`${base}/api/v1/sessions/${sessionId}`, auth).then((r) => r.json());
+    const record = detail.alerts.find((r) => String(r.alert.id) === alertId);
+    if (!record?.acknowledged_at)
+      fail(`alert ${alertId} is not stored as acknowledged: ${JSON.stringify(record)}`);
+    log(`alert ${alertId} "${alertText.split('\n')[0]}" acknowledged at ${record.acknowledged_at}`);
     await shot('alert-acknowledged');
 
     // The worker restarts; fly again if the hover left it airborne, else wait for take-off.
     await waitText('vision', (t) => t.startsWith('healthy'), 'the vision worker did not come back');
-    if ((await text('flight-state')) !== 'FLYING') {
-      await waitText('flight-state', (t) => t === 'READY', 'not READY to take off again');
-      await page.getByTestId('takeoff').click(); // the operator's button: input key t
+    if ((await text('flight-state')) === 'READY') {
+      // The twin landed itself while the worker was down (no command for 15 s): the operator's
+      // Take off button (input key t) lifts it again, else the next take-off gesture will.
+      await page
+        .getByTestId('takeoff')
+        .click({ timeout: 5000 })
+        .catch(() => log('take-off button not clickable; waiting for the gesture'));
     }
     await waitText('flight-state', (t) => t === 'FLYING', 'not flying before the emergency stop');
 
     // 6. Emergency stop (Space) brings it down.
     await page.locator('body').press('Space');
     await waitText('flight-state', (t) => t !== 'FLYING', 'still FLYING after the emergency stop');
-    await page.getByText('Emergency stop is latched').waitFor({ timeout: STEP_MS });
+    await page
+      .getByRole('alert')
+      .filter({ hasText: 'Emergency stop is latched' })
+      .waitFor({ timeout: STEP_MS });
     await waitText(
       'altitude',
       (t) => parseFloat(t) < 0.2,
@@ -306,6 +353,13 @@ async function main() {
     // 8. Log out: the socket closes, back to the login screen.
     await page.getByRole('button', { name: 'Log out' }).click();
     await page.getByText('You logged out.').waitFor({ timeout: STEP_MS });
+    await page.getByRole('button', { name: 'Log in', exact: true }).last().waitFor();
+    // Every /ws/live socket the page opened is closed.
+    for (const end = Date.now() + STEP_MS; sockets.some((w) => !w.isClosed());) {
+      if (Date.now() > end) fail('a /ws/live socket is still open after log-out');
+      await new Promise((r) => setTimeout(r, 100));
+    }
+    if (!sockets.length) fail('the page never opened /ws/live');
     await shot('logged-out');
 
     if (errors.length) fail(`errors in the page: ${errors.join('; ')}`);

@@ -10,7 +10,7 @@ import {
   saveLogin,
   type StoredLogin,
 } from './logic/auth';
-import { FrameBus } from './logic/frameBus';
+import { FrameBus, ViewBus } from './logic/frameBus';
 import { initialLiveState, liveReducer } from './logic/liveState';
 import { parseRoute, routeHash, type Route } from './logic/route';
 import { playAlarm } from './logic/sound';
@@ -50,6 +50,7 @@ export function App() {
   const [live, dispatch] = useReducer(liveReducer, initialLiveState);
   const [link, setLink] = useState<{ status: LinkStatus; detail?: string }>({ status: 'closed' });
   const frames = useMemo(() => new FrameBus(), []);
+  const views = useMemo(() => new ViewBus(), []);
   const connRef = useRef<LiveConnection | null>(null);
 
   const endLogin = useCallback(
@@ -62,8 +63,9 @@ export function App() {
       setLoginNotice(notice);
       dispatch({ kind: 'reset' });
       frames.clear();
+      views.clear();
     },
-    [frames],
+    [frames, views],
   );
 
   const api = useMemo(
@@ -89,6 +91,10 @@ export function App() {
           frames.push(msg.data);
           return;
         }
+        if (msg.type === 'drone_view') {
+          views.push(msg.data);
+          return;
+        }
         if (msg.type === 'alert' && msg.data.severity === 'CRITICAL' && !msg.replay) playAlarm();
         dispatch({ kind: 'message', message: msg, nowMs: Date.now() });
       },
@@ -106,7 +112,7 @@ export function App() {
     connRef.current = conn;
     conn.start();
     return () => conn.stop();
-  }, [login, api, endLogin, frames]);
+  }, [login, api, endLogin, frames, views]);
 
   useEffect(() => {
     if (!login) return;
@@ -127,7 +133,7 @@ export function App() {
 
   // For the end-to-end tests and for measuring: read-only counters.
   useEffect(() => {
-    (window as unknown as { __gbdcs?: unknown }).__gbdcs = { frames, live, link };
+    (window as unknown as { __gbdcs?: unknown }).__gbdcs = { frames, views, live, link };
   });
 
   const send = useCallback((m: WsClientMessage) => connRef.current?.send(m) ?? false, []);
@@ -201,6 +207,7 @@ export function App() {
           <FlyPage
             live={live}
             frames={frames}
+            views={views}
             send={send}
             api={api}
             config={config}

@@ -91,6 +91,11 @@ describe('reconnect back-off', () => {
 describe('parseServerMessage', () => {
   it('accepts the server envelope and rejects anything else', () => {
     expect(parseServerMessage('{"type":"telemetry","ts":"x","data":{}}')?.type).toBe('telemetry');
+    expect(
+      parseServerMessage(
+        '{"type":"drone_view","ts":"x","data":{"frame_id":0,"camera":"chase","width":1,"height":1,"jpeg":"AA=="}}',
+      )?.type,
+    ).toBe('drone_view');
     expect(parseServerMessage('{"type":"bogus","data":{}}')).toBeNull();
     expect(parseServerMessage('{"type":"alert"}')).toBeNull();
     expect(parseServerMessage('not json')).toBeNull();

@@ -69,6 +69,32 @@ describe('liveReducer', () => {
     expect(s.alerts).toHaveLength(1);
   });
 
+  it('keeps one banner per INFO code (newest, counted) but every warning and critical alert', () => {
+    const info = (id: number) => ({
+      kind: 'message' as const,
+      message: al(alert({ id, severity: 'INFO', code: 'VISION_RESTORED' })),
+      nowMs: id,
+    });
+    const s = run([
+      info(1),
+      info(2),
+      {
+        kind: 'message',
+        message: al(alert({ id: 3, severity: 'WARNING', code: 'BATTERY_LOW' })),
+        nowMs: 3,
+      },
+      {
+        kind: 'message',
+        message: al(alert({ id: 4, severity: 'WARNING', code: 'BATTERY_LOW' })),
+        nowMs: 4,
+      },
+      info(5),
+    ]);
+    const restored = s.alerts.filter((a) => a.alert.code === 'VISION_RESTORED');
+    expect(restored.map((a) => [a.key, a.count])).toEqual([['5', 3]]);
+    expect(s.alerts.filter((a) => a.alert.code === 'BATTERY_LOW')).toHaveLength(2);
+  });
+
   it('orders alerts critical first, then newest', () => {
     const s = run([
       {

@@ -151,3 +151,28 @@ describe('routes', () => {
     expect(parseRoute('#/nope')).toEqual({ page: 'fly' });
   });
 });
+
+describe('ViewBus', () => {
+  it('keeps the newest drone view, counts them, tells subscribers, and clears', async () => {
+    const { ViewBus } = await import('../src/logic/frameBus');
+    const bus = new ViewBus();
+    const seen: number[] = [];
+    const off = bus.subscribe((v) => seen.push(v.frame_id));
+    const view = (id: number) => ({
+      frame_id: id,
+      camera: 'chase',
+      width: 2,
+      height: 2,
+      jpeg: 'x',
+    });
+    bus.push(view(0));
+    bus.push(view(1));
+    expect(bus.latest?.frame_id).toBe(1);
+    expect(bus.received).toBe(2);
+    off();
+    bus.push(view(2));
+    expect(seen).toEqual([0, 1]);
+    bus.clear();
+    expect(bus.latest).toBeNull();
+  });
+});

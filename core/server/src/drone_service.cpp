@@ -1,6 +1,7 @@
 #include "gbdcs/server/drone_service.hpp"
 
 #include "gbdcs/contracts/codec.hpp"
+#include "gbdcs/server/auth.hpp"
 #include "gbdcs/control/keyboard_input.hpp"
 #include "gbdcs/gesture/gesture_engine.hpp"
 #include "gbdcs/gesture/rule_based_recognizer.hpp"
@@ -85,6 +86,7 @@ struct DroneService::Active {
   std::unique_ptr<runtime::ControlLoop> loop;
   std::int64_t session = 0;
   std::string name;
+  control::DroneViewSource* view = nullptr;  // the adapter, when it sends drone_view pictures
 };
 
 DroneService::DroneService(const contracts::Clock& clock, storage::StorageManager& storage,
@@ -116,6 +118,7 @@ void DroneService::end_session_quietly(std::int64_t session) {
 void DroneService::stop_active_locked() {
   if (!active_) return;
   auto& a = *active_;
+  if (a.view) a.view->stop_view();  // no picture of a drone we let go
   const auto state = a.adapter->state();
   if (state == contracts::FlightState::kFlying) {
     // Never leave a drone in the air without an operator: land before letting go.
@@ -183,8 +186,27 @@ std::string DroneService::connect(const std::string& name, const json& options) 
     reason = vision_reason_;
   }
   if (!healthy) a->loop->on_vision_health(false, reason);
+  auto* view_source = dynamic_cast<control::DroneViewSource*>(a->adapter.get());
+  if (view_source && options_.view.fps > 0) {
+    // The drone's own picture (the twin's chase camera), rendered on the adapter's thread at a
+    // low rate; sent only while somebody watches.
+    LiveHub* hub = &hub_;
+    const auto started = view_source->start_view(options_.view, [hub](const control::DroneView& v) {
+      if (hub->client_count() == 0) return;
+      hub->broadcast("drone_view", {{"frame_id", v.frame_id},
+                                    {"camera", v.camera},
+                                    {"width", v.width},
+                                    {"height", v.height},
+                                    {"jpeg", base64_encode(v.jpeg)}});
+    });
+    if (started == control::Result::kOk) {
+      a->view = view_source;
+    } else if (log_) {
+      log_("warn", {{"event", "drone_view_unavailable"}, {"cause", a->adapter->last_error()}});
+    }
+  }
   if (log_) log_("info", {{"event", "drone_connected"}, {"adapter", name},
-                          {"session_id", a->session}});
+                          {"session_id", a->session}, {"drone_view", a->view != nullptr}});
   active_ = std::move(a);
   lock.unlock();
   publish_state();
@@ -312,6 +334,7 @@ json DroneService::state() const {
         t ? t->flight_state : (active_ ? active_->adapter->state() : contracts::FlightState::kInit)));
     j["emergency_latched"] = active_ && active_->loop->arbiter().emergency_latched();
     j["vision"]["ready"] = active_ && active_->loop->vision_ready();
+    j["drone_view"] = active_ && active_->view != nullptr;
   }
   std::lock_guard s(status_mutex_);
   j["vision"]["healthy"] = vision_healthy_;

@@ -1,12 +1,17 @@
 #include "gbdcs/sim/twin_adapter.hpp"
 
+#include <mujoco/mujoco.h>
+
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <opencv2/imgcodecs.hpp>
 #include <stdexcept>
 
 #include "gbdcs/contracts/json_options.hpp"
+#include "gbdcs/sim/renderer.hpp"
 
 namespace gbdcs::sim {
 
@@ -130,6 +135,7 @@ TwinAdapter::TwinAdapter(const contracts::Clock& clock, std::shared_ptr<const Tw
 }
 
 TwinAdapter::~TwinAdapter() {
+  stop_view();
   stop_thread();
 }
 
@@ -271,6 +277,7 @@ Result TwinAdapter::connect() {
 }
 
 Result TwinAdapter::disconnect() {
+  stop_view();
   {
     std::lock_guard lock(mutex_);
     connected_ = false;
@@ -412,6 +419,83 @@ void TwinAdapter::thread_main() {
     tl.lock();
     thread_cv_.wait_for(tl, period, [this] { return thread_stop_; });
   }
+}
+
+// ---- view (the chase camera) -----------------------------------------------------------
+
+Result TwinAdapter::start_view(const control::ViewOptions& options, control::ViewSink sink) {
+  const bool ok = options.fps > 0 && options.fps <= 30 && options.width >= 16 &&
+                  options.width <= 1920 && options.height >= 16 && options.height <= 1080 &&
+                  options.jpeg_quality >= 1 && options.jpeg_quality <= 100 && sink;
+  if (!ok) {
+    std::lock_guard lock(mutex_);
+    last_error_ =
+        "view: fps must be in (0, 30], width 16...1920, height 16...1080, jpeg_quality "
+        "1...100, and a sink given";
+    return Result::kRejected;
+  }
+  stop_view();
+  {
+    std::lock_guard vl(view_mutex_);
+    view_stop_ = false;
+  }
+  view_thread_ = std::thread([this, options, sink = std::move(sink)]() mutable {
+    view_main(options, std::move(sink));
+  });
+  return Result::kOk;
+}
+
+void TwinAdapter::stop_view() {
+  {
+    std::lock_guard vl(view_mutex_);
+    view_stop_ = true;
+  }
+  view_cv_.notify_all();
+  if (view_thread_.joinable() && view_thread_.get_id() != std::this_thread::get_id()) {
+    view_thread_.join();
+  }
+}
+
+void TwinAdapter::view_main(control::ViewOptions options, control::ViewSink sink) {
+  const mjModel* m = model_->mj_model();
+  mjData* copy = nullptr;
+  try {
+    // The renderer's GL context belongs to this thread: made, used and destroyed here.
+    RendererOptions ro;
+    ro.width = options.width;
+    ro.height = options.height;
+    Renderer renderer(m, ro);
+    copy = mj_makeData(m);
+    if (!copy) throw std::runtime_error("mj_makeData failed (out of memory)");
+    const std::vector<int> params{cv::IMWRITE_JPEG_QUALITY, options.jpeg_quality};
+    const auto period = std::chrono::duration_cast<std::chrono::nanoseconds>(
+        std::chrono::duration<double>(1.0 / options.fps));
+    std::int64_t frame_id = 0;
+    std::unique_lock vl(view_mutex_);
+    while (!view_stop_) {
+      vl.unlock();
+      {
+        std::lock_guard lock(mutex_);  // between steps: a consistent state
+        mj_copyData(copy, m, sim_->data());
+      }
+      const cv::Mat bgr = renderer.render(copy, "chase");
+      std::vector<unsigned char> jpeg;
+      cv::imencode(".jpg", bgr, jpeg, params);
+      control::DroneView view;
+      view.jpeg.assign(jpeg.begin(), jpeg.end());
+      view.width = bgr.cols;
+      view.height = bgr.rows;
+      view.camera = "chase";
+      view.frame_id = frame_id++;
+      sink(view);
+      vl.lock();
+      view_cv_.wait_for(vl, period, [this] { return view_stop_; });
+    }
+  } catch (const std::exception& e) {
+    std::lock_guard lock(mutex_);
+    last_error_ = std::string("view: ") + e.what();
+  }
+  if (copy) mj_deleteData(copy);
 }
 
 }  // namespace gbdcs::sim

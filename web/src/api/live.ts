@@ -12,6 +12,7 @@ const SERVER_TYPES = new Set([
   'command',
   'state',
   'frame',
+  'drone_view',
   'ack_result',
   'error',
 ]);

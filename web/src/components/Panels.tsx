@@ -128,10 +128,12 @@ export function AlertBanners({ alerts, onAck, onDismiss }: AlertProps) {
           role={a.alert.severity === 'INFO' ? 'status' : 'alert'}
           data-testid="alert"
           data-code={a.alert.code}
+          data-alert-id={a.alert.id}
         >
           <div className="alert-text">
             <strong>
               {a.alert.severity} · {a.alert.code}
+              {a.count && a.count > 1 ? ` (×${a.count})` : ''}
             </strong>
             <span className="cause">{a.alert.cause}</span>
             <span className="suggestion">

@@ -463,6 +463,30 @@ export type WsCommandMessage = {
   data: WsCommandData;
 };
 
+/** One picture of the drone from its adapter's camera (the twin's chase camera), at a low rate (about 5 per second) and small size so it never competes with vision.
+ * Schema: core/contracts/schemas/ws_drone_view_data.schema.json */
+export type WsDroneViewData = {
+  /** counts from 0 for each connection of the drone */
+  frame_id: number;
+  /** which camera: "chase" (behind and above the twin) */
+  camera: string;
+  width: number;
+  height: number;
+  /** base64 JPEG (no data: prefix) */
+  jpeg: string;
+};
+
+/** The drone seen by its adapter's camera (the twin's chase camera); only from drones that have one (control::DroneViewSource).
+ * Schema: core/contracts/schemas/ws_drone_view_message.schema.json */
+export type WsDroneViewMessage = {
+  type: "drone_view";
+  /** UTC, ISO 8601 with milliseconds and Z */
+  ts: string;
+  /** true when the message comes from a stored session being replayed */
+  replay?: boolean;
+  data: WsDroneViewData;
+};
+
 /** Client -> server: stop the motors now (latches until POST /control/emergency-reset).
  * Schema: core/contracts/schemas/ws_emergency_stop.schema.json */
 export type WsEmergencyStop = {
@@ -537,7 +561,7 @@ export type WsInput = {
 
 /** Every message the server sends on /ws/live: {type, ts, replay?, data}.
  * Schema: core/contracts/schemas/ws_server_message.schema.json */
-export type WsServerMessage = WsGestureMessage | WsTelemetryMessage | WsAlertMessage | WsCommandMessage | WsStateMessage | WsFrameMessage | WsAckResultMessage | WsErrorMessage;
+export type WsServerMessage = WsGestureMessage | WsTelemetryMessage | WsAlertMessage | WsCommandMessage | WsStateMessage | WsFrameMessage | WsDroneViewMessage | WsAckResultMessage | WsErrorMessage;
 
 /** The server's view of the drone, the vision worker and replays: sent on connect and whenever it changes (at least every 2 s).
  * Schema: core/contracts/schemas/ws_state_data.schema.json */
@@ -564,6 +588,8 @@ export type WsStateData = {
     session_id: number;
     finished: boolean;
   };
+  /** true when the connected drone sends drone_view pictures (the twin's chase camera); absent from older servers */
+  drone_view?: boolean;
 };
 
 export const WS_STATE_DATA_FLIGHT_STATE = ["INIT","READY","FLYING","LANDING","FAULT"] as const;

@@ -1,21 +1,21 @@
-// The latest camera frame, outside React state: the feed canvas pulls it on each animation
-// frame, so 24-30 FPS of JPEGs never re-render the panels.
-import type { WsFrameData } from '../types';
+// The latest picture (camera frame, drone view) outside React state: the canvas or image that
+// shows it pulls or subscribes to it, so 24-30 FPS of JPEGs never re-render the panels.
+import type { WsDroneViewData, WsFrameData } from '../types';
 
-type Listener = (f: WsFrameData) => void;
+type Listener<T> = (f: T) => void;
 
-export class FrameBus {
-  latest: WsFrameData | null = null;
+export class LatestBus<T> {
+  latest: T | null = null;
   received = 0;
-  private listeners = new Set<Listener>();
+  private listeners = new Set<Listener<T>>();
 
-  push(f: WsFrameData): void {
+  push(f: T): void {
     this.latest = f;
     this.received++;
     for (const l of this.listeners) l(f);
   }
 
-  subscribe(l: Listener): () => void {
+  subscribe(l: Listener<T>): () => void {
     this.listeners.add(l);
     return () => this.listeners.delete(l);
   }
@@ -24,3 +24,9 @@ export class FrameBus {
     this.latest = null;
   }
 }
+
+/** Camera frames for the live feed. */
+export class FrameBus extends LatestBus<WsFrameData> {}
+
+/** Pictures of the drone from its adapter (the twin's chase camera). */
+export class ViewBus extends LatestBus<WsDroneViewData> {}

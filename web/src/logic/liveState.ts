@@ -1,6 +1,7 @@
 // The flying view's state, built from /ws/live messages by one pure reducer. The live socket
 // and the replay player both feed it, so the panels are the same whether live or replayed.
-// Camera frames do not pass through here (they go straight to the feed canvas at 24+ FPS).
+// Camera frames and drone views do not pass through here (they go straight to the feed canvas
+// and the drone-view image).
 import type {
   Alert,
   GestureEvent,
@@ -24,6 +25,8 @@ export interface AlertEntry {
   receivedAtMs: number;
   /** Sent an ack, waiting for ack_result. */
   acking: boolean;
+  /** INFO alerts of one code share a banner: how many arrived (absent: 1). */
+  count?: number;
 }
 
 export interface LiveState {
@@ -131,8 +134,19 @@ function onMessage(state: LiveState, msg: WsServerMessage, nowMs: number): LiveS
       const alert = msg.data;
       const key = alertKey(alert, `${nowMs}-${state.alerts.length}`);
       const cleared = CLEARED_BY[alert.code] ?? [];
-      let alerts = state.alerts.filter((a) => !cleared.includes(a.alert.code) && a.key !== key);
-      alerts = [...alerts, { key, alert, receivedAtMs: nowMs, acking: false }];
+      // An INFO alert replaces the earlier INFO banner of its code (newest wins, counted), so
+      // a flapping condition cannot push the flying view off the screen; warnings and critical
+      // alerts keep one banner each until acknowledged.
+      const same = (a: AlertEntry) =>
+        alert.severity === 'INFO' && a.alert.severity === 'INFO' && a.alert.code === alert.code;
+      const count = state.alerts.filter(same).reduce((n, a) => n + (a.count ?? 1), 0) + 1;
+      let alerts = state.alerts.filter(
+        (a) => !cleared.includes(a.alert.code) && a.key !== key && !same(a),
+      );
+      alerts = [
+        ...alerts,
+        { key, alert, receivedAtMs: nowMs, acking: false, ...(count > 1 ? { count } : {}) },
+      ];
       const idleHovering = alert.code === 'IDLE_HOVER' ? true : state.idleHovering;
       return { ...base, alerts, idleHovering };
     }
@@ -149,6 +163,7 @@ function onMessage(state: LiveState, msg: WsServerMessage, nowMs: number): LiveS
     case 'error':
       return { ...base, lastError: msg.data };
     case 'frame':
+    case 'drone_view':
       return base;
   }
 }

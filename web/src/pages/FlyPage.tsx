@@ -5,9 +5,10 @@ import { Api, ApiFailure } from '../api/http';
 import type { LinkStatus } from '../api/live';
 import { AlertBanners, CommandLog, GesturePanel, TelemetryPanel } from '../components/Panels';
 import { ErrorBox } from '../components/ErrorBox';
+import { DroneView } from '../components/DroneView';
 import { Feed } from '../components/Feed';
 import { PathMap } from '../components/PathMap';
-import type { FrameBus } from '../logic/frameBus';
+import type { FrameBus, ViewBus } from '../logic/frameBus';
 import { KeyTracker, type KeyOutput } from '../logic/keys';
 import type { AlertEntry, LiveAction, LiveState } from '../logic/liveState';
 import type { Config, WsClientMessage } from '../types';
@@ -15,6 +16,7 @@ import type { Config, WsClientMessage } from '../types';
 interface Props {
   live: LiveState;
   frames: FrameBus;
+  views: ViewBus;
   send: (m: WsClientMessage) => boolean;
   api: Api;
   config: Config | null;
@@ -22,7 +24,7 @@ interface Props {
   dispatch: Dispatch<LiveAction>;
 }
 
-export function FlyPage({ live, frames, send, api, config, link, dispatch }: Props) {
+export function FlyPage({ live, frames, views, send, api, config, link, dispatch }: Props) {
   const [failure, setFailure] = useState<ApiFailure | null>(null);
   const [notice, setNotice] = useState<string | null>(null);
   const keys = useMemo(() => new KeyTracker(), []);
@@ -199,7 +201,11 @@ export function FlyPage({ live, frames, send, api, config, link, dispatch }: Pro
           <ServerState live={live} />
         </div>
         <div className="fly-bottom">
-          <TwinView adapter={s?.adapter ?? null} />
+          <DroneView
+            views={views}
+            adapter={s?.adapter ?? null}
+            available={s?.drone_view === true}
+          />
           <CommandLog live={live} />
         </div>
       </div>
@@ -229,19 +235,6 @@ function ServerState({ live }: { live: LiveState }) {
           </dd>
         </dl>
       )}
-    </section>
-  );
-}
-
-function TwinView({ adapter }: { adapter: string | null }) {
-  if (adapter !== 'twin') return null;
-  return (
-    <section className="panel twin-view" aria-labelledby="twin-h">
-      <h2 id="twin-h">Twin chase camera</h2>
-      <p className="muted">
-        The server does not stream the twin’s chase camera yet (no message for it in docs/API.md);
-        the path map shows where the twin is.
-      </p>
     </section>
   );
 }

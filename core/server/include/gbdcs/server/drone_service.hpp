@@ -8,7 +8,9 @@
 //          on_vision_frame(msg)     a vision_frame message from the worker
 //          on_vision_health(ok, why), raise_alert(alert)
 //          emergency_stop / reset_emergency / key(key, pressed) / submit(command)
-// Outputs: hub messages gesture, command, alert, telemetry, state (every 1 s and on change);
+// Outputs: hub messages gesture, command, alert, telemetry, state (every 1 s and on change),
+//          drone_view (the adapter's picture, e.g. the twin's chase camera, at options.view.fps
+//          while a client is connected);
 //          the log callback gets one JSON object per command and safety event.
 //          Storage: when SQLite writes start failing (disk full, ...) the tick thread raises
 //          STORAGE_WRITE_FAILING (WARNING, cause and fix from storage::WriteHealth) and logs
@@ -30,6 +32,7 @@
 #include "gbdcs/contracts/clock.hpp"
 #include "gbdcs/control/command_translator.hpp"
 #include "gbdcs/control/drone_adapter.hpp"
+#include "gbdcs/control/drone_view.hpp"
 #include "gbdcs/runtime/control_loop.hpp"
 #include "gbdcs/server/live_hub.hpp"
 #include "gbdcs/storage/storage_manager.hpp"
@@ -44,6 +47,8 @@ struct DroneServiceOptions {
   double tick_s = 0.02;
   double state_every_s = 1.0;
   runtime::ControlLoopOptions loop;
+  // The drone's own picture (control::DroneViewSource) as drone_view messages; fps 0: off.
+  control::ViewOptions view;
 };
 
 struct VisionStatus {

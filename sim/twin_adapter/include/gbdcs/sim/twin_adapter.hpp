@@ -28,6 +28,11 @@
 //          realtime_step_hz 200 (10...2000), seed 1, model "" (TwinModel::default_model_path()),
 //          twin {} (TwinOptions::from_json: controller, battery, crash_speed_m_s,
 //          auto_land_after_s, faults).
+// View   : control::DroneViewSource: start_view() renders the twin's "chase" camera
+//          (sim/render, OSMesa on the CPU) on a thread of its own at options.fps (wall time; 0 < fps <= 30, 16...1920 x
+//          16...1080 px), from a copy of the state taken under the lock between steps, JPEG
+//          encoded, to the sink; stop_view(), disconnect() and the destructor end it. A
+//          renderer that cannot start (no OSMesa) ends the view with last_error() set.
 // Threads: every call may come from any thread; one mutex serialises them. The sink is called
 //          without the lock held (from poll() or the realtime thread).
 #pragma once
@@ -46,6 +51,7 @@
 
 #include "gbdcs/contracts/clock.hpp"
 #include "gbdcs/control/drone_adapter.hpp"
+#include "gbdcs/control/drone_view.hpp"
 #include "gbdcs/sim/twin_sim.hpp"
 
 namespace gbdcs::sim {
@@ -68,7 +74,7 @@ std::array<int, 4> motion_to_rc(const contracts::MotionPayload& motion,
 
 contracts::FlightState flight_state_of(TwinMode mode);
 
-class TwinAdapter final : public control::DroneAdapter {
+class TwinAdapter final : public control::DroneAdapter, public control::DroneViewSource {
  public:
   TwinAdapter(const contracts::Clock& clock, TwinAdapterOptions options = {});
   // Shares an already loaded model (tests, several twins); options.model_path is ignored.
@@ -90,6 +96,9 @@ class TwinAdapter final : public control::DroneAdapter {
   void set_telemetry_sink(control::TelemetrySink sink) override;
   void poll() override;
   std::string last_error() const override;
+  control::Result start_view(const control::ViewOptions& options,
+                             control::ViewSink sink) override;
+  void stop_view() override;
 
   // Twin-specific: the Tello rc command itself (each -100...100), held until the next command.
   control::Result rc(int a, int b, int c, int d);
@@ -117,6 +126,7 @@ class TwinAdapter final : public control::DroneAdapter {
   void start_thread_locked();
   void stop_thread();
   void thread_main();
+  void view_main(control::ViewOptions options, control::ViewSink sink);
 
   const contracts::Clock& clock_;
   TwinAdapterOptions options_;
@@ -142,6 +152,11 @@ class TwinAdapter final : public control::DroneAdapter {
   std::condition_variable thread_cv_;
   bool thread_stop_ = false;
   std::thread thread_;
+
+  std::mutex view_mutex_;
+  std::condition_variable view_cv_;
+  bool view_stop_ = false;
+  std::thread view_thread_;
 };
 
 }  // namespace gbdcs::sim
