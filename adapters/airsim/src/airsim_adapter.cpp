@@ -69,12 +69,7 @@ struct AirSimAdapter::Impl {
   }
 
   // Copies every string (no references into the buffer) and bounds what one frame may hold.
-  static std::unique_ptr<msgpack::unpacker> make_unpacker() {
-    return std::make_unique<msgpack::unpacker>(
-        [](msgpack::type::object_type, std::size_t, void*) { return false; }, nullptr,
-        MSGPACK_UNPACKER_INIT_BUFFER_SIZE,
-        msgpack::unpack_limit(100000, 100000, 1 << 20, 1 << 22, 1 << 20, 64));
-  }
+  static std::unique_ptr<msgpack::unpacker> make_unpacker() { return airsim::make_reply_unpacker(); }
 
   std::string where() const { return options.address + ":" + std::to_string(options.port); }
   std::string fix() const {
