@@ -1,9 +1,11 @@
 # Warnings for our own targets only; third-party headers come in as system includes.
 function(gbdcs_warnings target)
   target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor
-                                           -Wold-style-cast -Woverloaded-virtual
-                                           # GCC 12 false positive in std::string at -O3 (GCC PR 105329)
-                                           -Wno-restrict)
+                                           -Wold-style-cast -Woverloaded-virtual)
+  if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
+    # GCC 12 false positive in std::string at -O3 (GCC PR 105329); clang has no such flag.
+    target_compile_options(${target} PRIVATE -Wno-restrict)
+  endif()
   if(GBDCS_WERROR)
     target_compile_options(${target} PRIVATE -Werror)
   endif()

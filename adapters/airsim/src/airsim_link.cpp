@@ -40,10 +40,7 @@ void AirSimLink::stop() {
 
 // Copies every string (no references into the buffer) and bounds what one frame may hold.
 std::unique_ptr<msgpack::unpacker> AirSimLink::make_unpacker() {
-  return std::make_unique<msgpack::unpacker>(
-      [](msgpack::type::object_type, std::size_t, void*) { return false; }, nullptr,
-      MSGPACK_UNPACKER_INIT_BUFFER_SIZE,
-      msgpack::unpack_limit(100000, 100000, 1 << 20, 1 << 22, 1 << 20, 64));
+  return airsim::make_reply_unpacker();  // the bounds the fuzz target checks (airsim_rpc.hpp)
 }
 
 std::string AirSimLink::where() const {

@@ -60,6 +60,13 @@ std::string describe(const msgpack::object& o) {
   return out.str().substr(0, 200);
 }
 
+std::unique_ptr<msgpack::unpacker> make_reply_unpacker() {
+  return std::make_unique<msgpack::unpacker>(
+      [](msgpack::type::object_type, std::size_t, void*) { return false; }, nullptr,
+      MSGPACK_UNPACKER_INIT_BUFFER_SIZE,
+      msgpack::unpack_limit(100000, 100000, 1 << 20, 1 << 22, 1 << 20, 64));
+}
+
 std::optional<Response> decode_response(msgpack::object_handle&& message, std::string& why) {
   const msgpack::object& o = message.get();
   if (o.type != msgpack::type::ARRAY || o.via.array.size != 4) {

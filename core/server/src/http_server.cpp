@@ -7,6 +7,7 @@
 #include <boost/asio.hpp>
 #include <boost/beast.hpp>
 #include <boost/beast/websocket.hpp>
+#include <sstream>
 #include <thread>
 
 #include "api.hpp"
@@ -50,6 +51,19 @@ struct Server::Impl {
   bool stopped = false;
 
   void accept();
+
+  // The transport-free half of an HTTP exchange, shared by the sockets (HttpSession) and
+  // Server::answer (the fuzz target): parser limits, the error for an unparsable request,
+  // and routing a parsed request to its response (logged, counted).
+  using Request = http::request<http::string_body>;
+  using Response = http::response<http::string_body>;
+  void limit(http::request_parser<http::string_body>& parser) const;
+  Response parse_failure(beast::error_code ec, const std::string& remote);
+  Response respond(const Request& req, const std::string& remote);
+  ApiResponse dispatch(const Request& req, const std::string& remote, const std::string& rid,
+                       std::string& path);
+  void log_request(const std::string& rid, const std::string& method, const std::string& path,
+                   const std::string& remote, const ApiResponse& a, double ms);
 };
 
 namespace {
@@ -302,8 +316,7 @@ class HttpSession final : public std::enable_shared_from_this<HttpSession> {
  private:
   void read() {
     parser_.emplace();
-    parser_->body_limit(impl_.options.max_body_bytes);
-    parser_->header_limit(16 * 1024);
+    impl_.limit(*parser_);
     stream_.expires_after(std::chrono::seconds(30));
     http::async_read(stream_, buffer_, *parser_,
                      [self = shared_from_this()](beast::error_code ec, std::size_t) {
@@ -319,34 +332,12 @@ class HttpSession final : public std::enable_shared_from_this<HttpSession> {
       return;
     }
     if (ec) {
-      const auto rid = impl_.ids.next();
-      const bool too_large = ec == http::error::body_limit || ec == http::error::header_limit;
-      ApiError e(too_large ? 413 : 400, too_large ? "body_too_large" : "malformed_request",
-                 too_large ? "the request is larger than " +
-                                 std::to_string(impl_.options.max_body_bytes) + " bytes"
-                           : "the HTTP request cannot be parsed: " + ec.message(),
-                 too_large ? "send a smaller body (GBDCS_MAX_BODY_BYTES sets the limit)"
-                           : "send a well-formed HTTP/1.1 request");
-      auto a = error_response(e, rid);
-      log_request(rid, "?", "?", a, 0);
-      send(to_http(a, 11, false, rid), true);
+      send(impl_.parse_failure(ec, remote()), true);
       return;
     }
     Request req = parser_->release();
     if (websocket::is_upgrade(req)) return upgrade(std::move(req));
     handle(std::move(req));
-  }
-
-  void log_request(const std::string& rid, const std::string& method, const std::string& path,
-                   const ApiResponse& a, double ms) {
-    impl_.metrics.count_request(a.status);
-    impl_.metrics.request_ms.observe(ms);
-    if (!impl_.log) return;
-    json e = {{"event", "http"}, {"request_id", rid}, {"method", method},
-              {"path", path.substr(0, 200)}, {"status", a.status}, {"ms", ms},
-              {"remote", remote()}};
-    if (!a.log_detail.empty()) e["cause"] = a.log_detail;
-    impl_.log(a.status >= 500 ? "error" : (a.status >= 400 ? "warn" : "info"), e);
   }
 
   std::string remote() const {
@@ -355,58 +346,7 @@ class HttpSession final : public std::enable_shared_from_this<HttpSession> {
     return ec ? std::string("?") : ep.address().to_string();
   }
 
-  ApiResponse dispatch(const Request& req, const std::string& rid, std::string& path) {
-    const std::string target(req.target());
-    const auto qpos = target.find('?');
-    path = percent_decode(std::string_view(target).substr(0, qpos), false);
-    ApiRequest ar;
-    ar.method = std::string(req.method_string());
-    ar.path = path;
-    if (qpos != std::string::npos) ar.query = parse_query(std::string_view(target).substr(qpos + 1));
-    ar.body = req.body();
-    ar.content_type = std::string(req[http::field::content_type]);
-    ar.authorization = std::string(req[http::field::authorization]);
-    ar.remote = remote();
-    ar.request_id = rid;
-    try {
-      if (path == "/metrics") ar.path = "/api/v1/metrics";
-      if (ar.path == "/api/v1" || ar.path.rfind("/api/v1/", 0) == 0) return handle_api(impl_.ctx, ar);
-      if (ar.path.rfind("/api/", 0) == 0 || ar.path == "/ws/live" || ar.path == "/worker") {
-        throw ApiError(404, "not_found", "there is no route " + ar.method + " " + path.substr(0, 200),
-                       "the API is under /api/v1 (GET /api/v1/openapi.json); /ws/live needs a "
-                       "WebSocket upgrade");
-      }
-      if (req.method() != http::verb::get && req.method() != http::verb::head) {
-        ApiError e(405, "method_not_allowed", "static files are read-only", "use GET");
-        e.headers.emplace_back("Allow", "GET, HEAD");
-        throw e;
-      }
-      return serve_static(impl_.options.web_dir, path);
-    } catch (const ApiError& e) {
-      return error_response(e, rid);
-    } catch (const std::exception& e) {
-      return error_response(ApiError(500, "internal", e.what(),
-                                     "retry; if it persists, report the request id with the "
-                                     "server log"),
-                            rid);
-    }
-  }
-
-  void handle(Request req) {
-    const auto t0 = impl_.clock.now();
-    const auto rid = impl_.ids.next();
-    std::string path;
-    auto a = dispatch(req, rid, path);
-    log_request(rid, std::string(req.method_string()), path, a,
-                contracts::to_seconds(impl_.clock.now() - t0) * 1000.0);
-    auto res = to_http(a, req.version(), req.keep_alive(), rid);
-    if (req.method() == http::verb::head) {
-      const auto length = res.body().size();
-      res.body().clear();
-      res.content_length(length);
-    }
-    send(std::move(res), !req.keep_alive());
-  }
+  void handle(Request req) { send(impl_.respond(req, remote()), !req.keep_alive()); }
 
   void send(Response res, bool close) {
     auto sp = std::make_shared<Response>(std::move(res));
@@ -425,7 +365,8 @@ class HttpSession final : public std::enable_shared_from_this<HttpSession> {
     impl_.metrics.ws_rejected++;
     const auto rid = impl_.ids.next();
     auto a = error_response(e, rid);
-    log_request(rid, "GET", std::string(req.target()).substr(0, std::string(req.target()).find('?')), a, 0);
+    impl_.log_request(rid, "GET", std::string(req.target()).substr(0, std::string(req.target()).find('?')),
+                      remote(), a, 0);
     send(to_http(a, req.version(), false, rid), true);
   }
 
@@ -494,6 +435,92 @@ class HttpSession final : public std::enable_shared_from_this<HttpSession> {
 
 }  // namespace
 
+// ---- the transport-free half (sockets and Server::answer) ---------------------------------
+void Server::Impl::limit(http::request_parser<http::string_body>& parser) const {
+  parser.body_limit(options.max_body_bytes);
+  parser.header_limit(16 * 1024);
+}
+
+Server::Impl::Response Server::Impl::parse_failure(beast::error_code ec, const std::string& remote) {
+  const auto rid = ids.next();
+  const bool too_large = ec == http::error::body_limit || ec == http::error::header_limit;
+  ApiError e(too_large ? 413 : 400, too_large ? "body_too_large" : "malformed_request",
+             too_large ? "the request is larger than " + std::to_string(options.max_body_bytes) + " bytes"
+                       : "the HTTP request cannot be parsed: " + ec.message(),
+             too_large ? "send a smaller body (GBDCS_MAX_BODY_BYTES sets the limit)"
+                       : "send a well-formed HTTP/1.1 request");
+  auto a = error_response(e, rid);
+  log_request(rid, "?", "?", remote, a, 0);
+  return to_http(a, 11, false, rid);
+}
+
+void Server::Impl::log_request(const std::string& rid, const std::string& method,
+                               const std::string& path, const std::string& remote,
+                               const ApiResponse& a, double ms) {
+  metrics.count_request(a.status);
+  metrics.request_ms.observe(ms);
+  if (!log) return;
+  json e = {{"event", "http"}, {"request_id", rid}, {"method", method},
+            {"path", path.substr(0, 200)}, {"status", a.status}, {"ms", ms},
+            {"remote", remote}};
+  if (!a.log_detail.empty()) e["cause"] = a.log_detail;
+  log(a.status >= 500 ? "error" : (a.status >= 400 ? "warn" : "info"), e);
+}
+
+ApiResponse Server::Impl::dispatch(const Request& req, const std::string& remote,
+                                   const std::string& rid, std::string& path) {
+  const std::string target(req.target());
+  const auto qpos = target.find('?');
+  path = percent_decode(std::string_view(target).substr(0, qpos), false);
+  ApiRequest ar;
+  ar.method = std::string(req.method_string());
+  ar.path = path;
+  if (qpos != std::string::npos) ar.query = parse_query(std::string_view(target).substr(qpos + 1));
+  ar.body = req.body();
+  ar.content_type = std::string(req[http::field::content_type]);
+  ar.authorization = std::string(req[http::field::authorization]);
+  ar.remote = remote;
+  ar.request_id = rid;
+  try {
+    if (path == "/metrics") ar.path = "/api/v1/metrics";
+    if (ar.path == "/api/v1" || ar.path.rfind("/api/v1/", 0) == 0) return handle_api(ctx, ar);
+    if (ar.path.rfind("/api/", 0) == 0 || ar.path == "/ws/live" || ar.path == "/worker") {
+      throw ApiError(404, "not_found", "there is no route " + ar.method + " " + path.substr(0, 200),
+                     "the API is under /api/v1 (GET /api/v1/openapi.json); /ws/live needs a "
+                     "WebSocket upgrade");
+    }
+    if (req.method() != http::verb::get && req.method() != http::verb::head) {
+      ApiError e(405, "method_not_allowed", "static files are read-only", "use GET");
+      e.headers.emplace_back("Allow", "GET, HEAD");
+      throw e;
+    }
+    return serve_static(options.web_dir, path);
+  } catch (const ApiError& e) {
+    return error_response(e, rid);
+  } catch (const std::exception& e) {
+    return error_response(ApiError(500, "internal", e.what(),
+                                   "retry; if it persists, report the request id with the "
+                                   "server log"),
+                          rid);
+  }
+}
+
+Server::Impl::Response Server::Impl::respond(const Request& req, const std::string& remote) {
+  const auto t0 = clock.now();
+  const auto rid = ids.next();
+  std::string path;
+  auto a = dispatch(req, remote, rid, path);
+  log_request(rid, std::string(req.method_string()), path, remote, a,
+              contracts::to_seconds(clock.now() - t0) * 1000.0);
+  auto res = to_http(a, req.version(), req.keep_alive(), rid);
+  if (req.method() == http::verb::head) {
+    const auto length = res.body().size();
+    res.body().clear();
+    res.content_length(length);
+  }
+  return res;
+}
+
 void Server::Impl::accept() {
   acceptor.async_accept(net::make_strand(ioc), [this](beast::error_code ec, tcp::socket socket) {
     if (ec == net::error::operation_aborted || !acceptor.is_open()) return;
@@ -561,6 +588,51 @@ void Server::stop() {
   for (auto& t : i.threads) {
     if (t.joinable()) t.join();
   }
+}
+
+std::string Server::answer(std::string_view request_bytes, const std::string& remote,
+                           int max_requests) {
+  auto& i = *impl_;
+  std::string out;
+  for (int n = 0; n < max_requests && !request_bytes.empty(); ++n) {
+    http::request_parser<http::string_body> parser;
+    i.limit(parser);
+    parser.eager(true);
+    beast::error_code ec;
+    // The input is everything the peer sent before closing: parse what it holds, then EOF.
+    // Stops when the bytes run out: put() on an empty buffer mid-body consumes nothing and
+    // reports nothing (the fuzz target found that loop: fuzz_regressions/rest_request/).
+    while (!parser.is_done() && !request_bytes.empty()) {
+      const auto used = parser.put(net::buffer(request_bytes.data(), request_bytes.size()), ec);
+      request_bytes.remove_prefix(used);
+      if (ec == http::error::need_more) ec = {};
+      if (ec || used == 0) break;
+    }
+    if (!ec && !parser.is_done()) {
+      parser.put_eof(ec);
+      if (ec == http::error::end_of_stream) return out;  // the peer sent nothing more
+    }
+    if (ec || !parser.is_done()) {
+      std::ostringstream s;
+      s << i.parse_failure(ec ? ec : beast::error_code(http::error::partial_message), remote);
+      return out + s.str();
+    }
+    const Impl::Request& req = parser.get();
+    std::ostringstream s;
+    if (websocket::is_upgrade(req)) {
+      const auto rid = i.ids.next();
+      auto a = error_response(ApiError(400, "upgrade_needs_socket",
+                                       "a WebSocket upgrade cannot be answered without a socket",
+                                       "connect over TCP"),
+                              rid);
+      s << to_http(a, req.version(), false, rid);
+      return out + s.str();
+    }
+    s << i.respond(req, remote);
+    out += s.str();
+    if (!req.keep_alive()) break;
+  }
+  return out;
 }
 
 unsigned short Server::port() const { return impl_->acceptor.local_endpoint().port(); }

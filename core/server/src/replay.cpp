@@ -14,7 +14,7 @@ std::int64_t ms(contracts::UtcTime t) { return t.time_since_epoch().count(); }
 
 ReplayManager::ReplayManager(const contracts::Clock& clock, storage::StorageManager& storage,
                              LiveHub& hub, DroneService& drone)
-    : clock_(clock), storage_(storage), hub_(hub), drone_(drone), ids_(clock) {}
+    : storage_(storage), hub_(hub), drone_(drone), ids_(clock) {}
 
 ReplayManager::~ReplayManager() { stop_all(); }
 

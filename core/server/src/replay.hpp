@@ -43,7 +43,6 @@ class ReplayManager {
     std::string type;
     nlohmann::json data;
   };
-  const contracts::Clock& clock_;
   storage::StorageManager& storage_;
   LiveHub& hub_;
   DroneService& drone_;

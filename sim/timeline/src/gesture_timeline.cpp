@@ -76,7 +76,8 @@ GestureTimeline GestureTimeline::from_json(const nlohmann::json& doc) {
     std::vector<const char*> keys = {"pose", "duration_s", "transition_s"};
     keys.insert(keys.end(), kPlacementKeys.begin(), kPlacementKeys.end());
     if (!s.is_object()) throw TimelineError(where + ": expected a JSON object");
-    for (const auto& [key, value] : s.items()) {
+    for (const auto& item : s.items()) {
+      const std::string& key = item.key();  // not a structured binding: clang 14 cannot capture one
       if (std::find_if(keys.begin(), keys.end(), [&](const char* k) { return key == k; }) ==
           keys.end()) {
         throw TimelineError(where + ": unknown field '" + key + "'");

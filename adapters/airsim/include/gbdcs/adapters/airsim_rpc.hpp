@@ -13,6 +13,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <msgpack.hpp>
 #include <optional>
 #include <string>
@@ -59,6 +60,11 @@ std::string encode_request(std::uint32_t msgid, const std::string& method,
 
 // A YawMode map: {is_rate, yaw_or_rate}.
 void pack_yaw_mode(msgpack::packer<msgpack::sbuffer>& p, bool is_rate, double yaw_or_rate);
+
+// The unpacker for the server's byte stream: strings and binaries are copied out of its
+// buffer, and one message is bounded (100000 array/map entries, 1 MiB strings, 4 MiB
+// binaries, 64 levels deep); past a bound next() throws.
+std::unique_ptr<msgpack::unpacker> make_reply_unpacker();
 
 // A message from the server: a Response, or nullopt with `why` (not a response frame).
 std::optional<Response> decode_response(msgpack::object_handle&& message, std::string& why);

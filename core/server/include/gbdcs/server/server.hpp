@@ -12,6 +12,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "gbdcs/contracts/clock.hpp"
@@ -53,6 +54,14 @@ class Server {
   void stop();
   unsigned short port() const;
   Metrics& metrics();
+
+  // Answers raw HTTP/1.1 bytes without a socket (the REST fuzz target, fuzz/rest_request.cpp):
+  // the connection's parser limits, error envelope, routing and handlers, up to `max_requests`
+  // pipelined requests while each keeps the connection alive. Returns the raw responses, in
+  // order; "" when the bytes hold no request. Needs no start(). A WebSocket upgrade is
+  // answered 400 (upgrades need a socket).
+  std::string answer(std::string_view request_bytes, const std::string& remote = "127.0.0.1",
+                     int max_requests = 8);
 
   struct Impl;
 
