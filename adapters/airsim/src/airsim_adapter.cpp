@@ -20,7 +20,6 @@ namespace asio = boost::asio;
 using asio::ip::tcp;
 using contracts::FlightState;
 using control::Result;
-using WallClock = std::chrono::steady_clock;
 using Packer = msgpack::packer<msgpack::sbuffer>;
 
 namespace {
@@ -47,7 +46,7 @@ struct AirSimAdapter::Impl {
     msgpack::object_handle result;
     bool deferred = false;  // nobody waits: a late error or `false` is logged
     bool is_state = false;
-    WallClock::time_point expires;
+    contracts::Duration expires{0};  // on the injected clock
   };
 
   Impl(const contracts::Clock& c, AirSimOptions o)
@@ -298,8 +297,7 @@ struct AirSimAdapter::Impl {
     c->is_state = is_state;
     const double life_s = deferred ? std::max(options.takeoff_timeout_s, options.land_timeout_s) + 5
                                    : options.rpc_timeout_ms / 1000.0;
-    c->expires = WallClock::now() + std::chrono::duration_cast<WallClock::duration>(
-                                        std::chrono::duration<double>(life_s));
+    c->expires = clock.now() + contracts::from_seconds(life_s);
     const auto id = next_id++;
     const auto bytes = airsim::encode_request(id, method, [&](Packer& p) { params(p); });
     calls[id] = c;
@@ -324,8 +322,7 @@ struct AirSimAdapter::Impl {
     if (!c->done) {
       if (deferred) {
         c->deferred = true;
-        c->expires = WallClock::now() + std::chrono::seconds(
-                                            static_cast<long>(options.land_timeout_s + 5));
+        c->expires = clock.now() + contracts::from_seconds(options.land_timeout_s + 5);
       }
     }
     return c;
@@ -411,9 +408,11 @@ struct AirSimAdapter::Impl {
     control::TelemetrySink to;
     {
       std::lock_guard lock(mutex);
-      const auto wall = WallClock::now();
+      // Calls nobody waits for any more expire on the injected clock (simulated time in a
+      // lockstep run); the blocking waits themselves are real time (a socket's).
+      const auto expire_before = clock.now();
       for (auto it = calls.begin(); it != calls.end();) {
-        if (it->second->expires < wall) {
+        if (it->second->expires < expire_before) {
           it->second->done = true;
           it = calls.erase(it);
         } else {

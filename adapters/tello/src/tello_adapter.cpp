@@ -20,7 +20,6 @@ namespace asio = boost::asio;
 using asio::ip::udp;
 using contracts::FlightState;
 using control::Result;
-using WallClock = std::chrono::steady_clock;
 
 namespace {
 
@@ -29,7 +28,7 @@ constexpr auto kTickPeriod = std::chrono::milliseconds(10);
 constexpr int kStopBurst = 3;         // rc 0 0 0 0 sent this many times when the sticks centre
 constexpr double kLandSettleS = 0.5;  // at ground height this long: landed
 constexpr double kAutoLandSettleS = 1.0;
-constexpr double kDeferredReplyS = 20;  // take-off/land replies come within this (wall)
+constexpr double kDeferredReplyS = 20;  // take-off/land replies come within this (clock)
 
 double wrap_deg(double deg) {
   double w = std::fmod(deg, 360.0);
@@ -64,7 +63,7 @@ struct TelloAdapter::Impl {
     bool answered = false;  // `reply` holds the drone's answer
     bool deferred = false;  // the caller stopped waiting (take-off/land): outcome logged only
     std::string reply;
-    WallClock::time_point expires;
+    contracts::Duration expires{0};  // on the injected clock
   };
 
   Impl(const contracts::Clock& c, TelloOptions o)
@@ -283,7 +282,7 @@ struct TelloAdapter::Impl {
     if (expect_reply) {
       p = std::make_shared<Pending>();
       p->command = text;
-      p->expires = WallClock::now() + std::chrono::milliseconds(options.reply_timeout_ms);
+      p->expires = clock.now() + contracts::from_seconds(options.reply_timeout_ms / 1000.0);
       pending.push_back(p);
     }
     boost::system::error_code ec;
@@ -318,8 +317,7 @@ struct TelloAdapter::Impl {
     if (p->done) return std::nullopt;  // expired or abandoned (an emergency cleared it)
     if (deferred) {
       p->deferred = true;
-      p->expires = WallClock::now() + std::chrono::duration_cast<WallClock::duration>(
-                                          std::chrono::duration<double>(kDeferredReplyS));
+      p->expires = clock.now() + contracts::from_seconds(kDeferredReplyS);
     } else {
       abandon_locked(p);
     }
@@ -381,13 +379,14 @@ struct TelloAdapter::Impl {
     control::TelemetrySink to;
     {
       std::lock_guard lock(mutex);
-      const auto wall = WallClock::now();
-      while (!pending.empty() && pending.front()->expires < wall) {
+      // Replies nobody waits for (keep-alive, take-off/land) expire on the injected clock,
+      // so a lockstep run gives a lost one up after the same simulated time as a real flight.
+      const auto now = clock.now();
+      while (!pending.empty() && pending.front()->expires < now) {
         pending.front()->done = true;  // never answered: lost
         pending.pop_front();
       }
       if (!connected) return;
-      const auto now = clock.now();
       const double since_state =
           contracts::to_seconds(now - (have_state ? last_state_at : connected_at));
       if (!link_lost && since_state > options.link_timeout_s) {
