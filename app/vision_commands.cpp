@@ -4,7 +4,6 @@
 #include <atomic>
 #include <csignal>
 #include <filesystem>
-#include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <mutex>
@@ -16,6 +15,7 @@
 #include "command_registry.hpp"
 #include "commands.hpp"
 #include "gbdcs/contracts/codec.hpp"
+#include "gbdcs/contracts/json_file.hpp"
 #include "gbdcs/vision/model_files.hpp"
 #include "gbdcs/vision/vision_messages.hpp"
 #include "gbdcs/vision/vision_pipeline.hpp"
@@ -37,18 +37,6 @@ void on_signal(int) {
 // OpenCV's own warnings (backends it tried) would bury our one clear message.
 void quiet_opencv() {
   cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_ERROR);
-}
-
-json read_json_file(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error(path + ": cannot read (check the path)");
-  std::stringstream text;
-  text << in.rdbuf();
-  try {
-    return contracts::parse_json(text.str());
-  } catch (const std::exception& e) {
-    throw std::runtime_error(path + ": " + e.what());
-  }
 }
 
 // ---- gbdcs vision -----------------------------------------------------------------------
@@ -91,7 +79,8 @@ int run_vision(const VisionOptions& o) {
   contracts::SteadyClock clock;
   vision::PipelineOptions options;
   if (!o.options_file.empty())
-    options = vision::pipeline_options_from_json(read_json_file(o.options_file));
+    options = vision::pipeline_options_from_json(
+        contracts::read_json_file<std::runtime_error>(o.options_file, "pipeline options file"));
   std::unique_ptr<vision::CaptureSource> source;
   std::unique_ptr<vision::HandFinder> finder;
   JpegTap* tap = nullptr;
@@ -265,8 +254,10 @@ std::string pct(const std::optional<double>& v) {
 }
 
 int run_eval_landmarks(const EvalOptions& o) {
-  const auto ours = vision::recognized_from_json(read_json_file(o.ours));
-  const auto ref = vision::recognized_from_json(read_json_file(o.ref));
+  const auto ours = vision::recognized_from_json(
+      contracts::read_json_file<std::runtime_error>(o.ours, "landmarks file"));
+  const auto ref = vision::recognized_from_json(
+      contracts::read_json_file<std::runtime_error>(o.ref, "reference landmarks file"));
   const auto c = vision::compare_landmarks(ours, ref);
   const bool detection_ok = c.hands_only_ours == 0 && c.hands_only_ref == 0;
   const bool accuracy_ok = !c.mean_distance_pct || *c.mean_distance_pct <= o.max_mean_pct;

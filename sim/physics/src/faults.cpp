@@ -2,12 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <nlohmann/json.hpp>
-#include <sstream>
 #include <stdexcept>
 
 #include "counter_rng.hpp"
+#include "gbdcs/contracts/json_file.hpp"
 #include "gbdcs/contracts/json_options.hpp"
 
 namespace gbdcs::sim {
@@ -171,15 +170,8 @@ FaultSchedule FaultSchedule::from_json_text(std::string_view text) {
 }
 
 FaultSchedule FaultSchedule::load(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::invalid_argument("FaultSchedule: cannot read '" + path + "'");
-  std::stringstream text;
-  text << in.rdbuf();
-  try {
-    return from_json_text(text.str());
-  } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument(path + ": " + e.what());
-  }
+  const auto doc = contracts::read_json_file<std::invalid_argument>(path, "fault schedule");
+  return contracts::prefix_errors<std::invalid_argument>(path, [&] { return from_json(doc); });
 }
 
 nlohmann::json FaultSchedule::to_json() const {
