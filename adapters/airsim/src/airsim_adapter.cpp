@@ -1,32 +1,29 @@
 #include "gbdcs/adapters/airsim_adapter.hpp"
 
 #include <algorithm>
-#include <boost/asio.hpp>
 #include <chrono>
 #include <cmath>
-#include <condition_variable>
-#include <functional>
-#include <map>
 #include <mutex>
 #include <numbers>
 #include <optional>
-#include <thread>
+#include <vector>
 
+#include "airsim_link.hpp"
 #include "gbdcs/adapters/airsim_rpc.hpp"
+
+// The DroneAdapter mapping: flight states, NED to the session frame, the move stream and the
+// link watchdog. The connection, request matching and reconnects are AirSimLink's
+// (airsim_link.hpp).
 
 namespace gbdcs::adapters {
 
-namespace asio = boost::asio;
-using asio::ip::tcp;
 using contracts::FlightState;
 using control::Result;
-using Packer = msgpack::packer<msgpack::sbuffer>;
+using Packer = detail::AirSimLink::Packer;
 
 namespace {
 
 constexpr double kDegToRad = std::numbers::pi / 180.0;
-constexpr auto kTickPeriod = std::chrono::milliseconds(10);
-constexpr std::size_t kMaxBuffered = 4 << 20;  // a frame bigger than this is not AirSim's
 
 double wrap_deg(double deg) {
   double w = std::fmod(deg, 360.0);
@@ -36,197 +33,30 @@ double wrap_deg(double deg) {
 
 }  // namespace
 
-struct AirSimAdapter::Impl {
-  struct Call {
-    std::string method;
-    bool done = false;      // answered, expired or its connection lost
-    bool answered = false;  // ok/error/result hold the server's answer
-    bool ok = false;
-    std::string error;
-    msgpack::object_handle result;
-    bool deferred = false;  // nobody waits: a late error or `false` is logged
-    bool is_state = false;
-    contracts::Duration expires{0};  // on the injected clock
-  };
+struct AirSimAdapter::Impl final : detail::AirSimLink {
+  Impl(const contracts::Clock& c, AirSimOptions o) : AirSimLink(c, std::move(o)) { start(); }
+  ~Impl() override { stop(); }
 
-  Impl(const contracts::Clock& c, AirSimOptions o)
-      : clock(c), options(std::move(o)), socket(io), tick_timer(io), unpacker(make_unpacker()) {
-    boost::system::error_code ec;
-    const auto address = asio::ip::make_address(options.address, ec);
-    if (ec) {
-      throw std::invalid_argument("airsim options: 'address' '" + options.address +
-                                  "' is not an IP address");
-    }
-    server = tcp::endpoint(address, static_cast<unsigned short>(options.port));
-    schedule_tick();
-    io_thread = std::thread([this] { io.run(); });
+  // ---- link hooks (I/O thread, lock held) -------------------------------------------------
+
+  void on_redialled_locked() override {  // ask for control again, fire and forget
+    call_locked("enableApiControl", [&](Packer& p) {
+      p.pack_array(2);
+      p.pack(true);
+      p.pack(options.vehicle);
+    }, true);
+    call_locked("armDisarm", [&](Packer& p) {
+      p.pack_array(2);
+      p.pack(true);
+      p.pack(options.vehicle);
+    }, true);
   }
 
-  ~Impl() {
-    io.stop();
-    if (io_thread.joinable()) io_thread.join();
-  }
-
-  // Copies every string (no references into the buffer) and bounds what one frame may hold.
-  static std::unique_ptr<msgpack::unpacker> make_unpacker() {
-    return std::make_unique<msgpack::unpacker>(
-        [](msgpack::type::object_type, std::size_t, void*) { return false; }, nullptr,
-        MSGPACK_UNPACKER_INIT_BUFFER_SIZE,
-        msgpack::unpack_limit(100000, 100000, 1 << 20, 1 << 22, 1 << 20, 64));
-  }
-
-  std::string where() const { return options.address + ":" + std::to_string(options.port); }
-  std::string fix() const {
-    return "start the AirSim environment (Unreal, a multirotor vehicle) or `gbdcs twin "
-           "--airsim`, and check 'address'/'port' in the airsim options against "
-           "settings.json's ApiServerPort";
-  }
-
-  // ---- connection (I/O thread) ------------------------------------------------------------
-
-  void dial() {  // with `mutex` held; completes on the I/O thread
-    dialing = true;
-    ++dial_generation;
-    const auto generation = dial_generation;
-    asio::post(io, [this, generation] {
-      boost::system::error_code ignored;
-      socket.close(ignored);
-      unpacker = make_unpacker();
-      socket.async_connect(server, [this, generation](boost::system::error_code ec) {
-        std::lock_guard lock(mutex);
-        if (generation != dial_generation) return;
-        dialing = false;
-        dial_error = ec ? ec.message() : "";
-        if (!ec) {
-          boost::system::error_code e2;
-          socket.set_option(tcp::no_delay(true), e2);
-          socket_up = true;
-          ++stats.connects;
-          backoff_s = options.reconnect_min_s;
-          read();
-          if (connected) {  // a re-dial: ask for control again, fire and forget
-            call_locked("enableApiControl", [&](Packer& p) {
-              p.pack_array(2);
-              p.pack(true);
-              p.pack(options.vehicle);
-            }, true);
-            call_locked("armDisarm", [&](Packer& p) {
-              p.pack_array(2);
-              p.pack(true);
-              p.pack(options.vehicle);
-            }, true);
-          }
-        } else if (connected) {
-          reconnect_at = clock.now() + contracts::from_seconds(backoff_s);
-          backoff_s = std::min(backoff_s * 2, options.reconnect_max_s);
-        }
-        cv.notify_all();
-      });
-    });
-  }
-
-  void read() {
-    socket.async_read_some(asio::buffer(read_buffer), [this](boost::system::error_code ec,
-                                                             std::size_t n) {
-      if (ec == asio::error::operation_aborted) return;
-      if (ec) {
-        lost_socket("the connection to AirSim at " + where() + " closed: " + ec.message());
-        return;
-      }
-      if (!on_bytes(n)) return;
-      read();
-    });
-  }
-
-  void lost_socket(const std::string& why) {
-    std::lock_guard lock(mutex);
-    lost_socket_locked(why);
-  }
-
-  void lost_socket_locked(const std::string& why) {
-    if (!socket_up) return;
-    socket_up = false;
-    boost::system::error_code ignored;
-    socket.close(ignored);
-    last_error = why + " (reconnecting)";
-    stats.lost_requests += calls.size();
-    for (auto& [id, c] : calls) {
-      c->done = true;
-      c->error = "connection lost";
-    }
-    calls.clear();
-    cv.notify_all();
-    reconnect_at = clock.now() + contracts::from_seconds(backoff_s);
-  }
-
-  // Feeds the unpacker; false when the stream is broken (the socket is dropped).
-  bool on_bytes(std::size_t n) {
-    std::vector<contracts::TelemetryFrame> frames;
-    control::TelemetrySink to;
-    {
-      std::lock_guard lock(mutex);
-      if (unpacker->nonparsed_size() + n > kMaxBuffered) {
-        ++stats.malformed;
-        stats.last_malformed = "a frame larger than 4 MiB";
-        lost_socket_locked("AirSim sent a frame larger than 4 MiB");
-        return false;
-      }
-      unpacker->reserve_buffer(n);
-      std::copy_n(read_buffer.data(), n, unpacker->buffer());
-      unpacker->buffer_consumed(n);
-      try {
-        msgpack::object_handle message;
-        while (unpacker->next(message)) on_message(std::move(message), frames);
-      } catch (const std::exception& e) {
-        ++stats.malformed;
-        stats.last_malformed = std::string("undecodable msgpack: ") + e.what();
-        lost_socket_locked("AirSim sent undecodable msgpack (" + std::string(e.what()) + ")");
-        return false;
-      }
-      to = sink;
-    }
-    if (to && !frames.empty()) {
-      std::lock_guard order(sink_mutex);
-      for (const auto& f : frames) to(f);
-    }
-    return true;
-  }
-
-  void on_message(msgpack::object_handle&& message,
-                  std::vector<contracts::TelemetryFrame>& frames) {
-    std::string why;
-    auto response = airsim::decode_response(std::move(message), why);
-    if (!response) {
-      ++stats.malformed;
-      stats.last_malformed = why;
-      return;
-    }
-    ++stats.responses;
-    const auto it = calls.find(response->msgid);
-    if (it == calls.end()) return;  // abandoned (timed out) or from before a reconnect
-    auto call = it->second;
-    calls.erase(it);
-    call->done = true;
-    call->answered = true;
-    call->ok = response->ok;
-    call->error = response->error;
-    call->result = std::move(response->result);
-    if (call->is_state) {
-      state_outstanding.reset();
-      if (call->ok) on_state(call->result.get(), frames);
-    } else if (call->deferred) {
-      const auto& r = call->result.get();
-      if (!call->ok) {
-        last_error = call->method + ": AirSim answered: " + call->error;
-      } else if (r.type == msgpack::type::BOOLEAN && !r.via.boolean &&
-                 call->method != "moveByVelocityBodyFrame") {
-        last_error = call->method + ": AirSim answered false (timed out or cancelled)";
-      }
-    }
-    cv.notify_all();
-  }
-
-  void on_state(const msgpack::object& o, std::vector<contracts::TelemetryFrame>& frames) {
+  void on_state_response_locked(const Call& call,
+                                std::vector<contracts::TelemetryFrame>& frames) override {
+    state_outstanding.reset();
+    if (!call.ok) return;
+    const msgpack::object& o = call.result.get();
     std::string why;
     const auto s = airsim::decode_multirotor_state(o, why);
     if (!s) {
@@ -287,47 +117,6 @@ struct AirSimAdapter::Impl {
 
   // ---- calls ------------------------------------------------------------------------------
 
-  std::shared_ptr<Call> call_locked(const std::string& method,
-                                    const std::function<void(Packer&)>& params, bool deferred,
-                                    bool is_state = false) {
-    if (!socket_up) return nullptr;
-    auto c = std::make_shared<Call>();
-    c->method = method;
-    c->deferred = deferred;
-    c->is_state = is_state;
-    const double life_s = deferred ? std::max(options.takeoff_timeout_s, options.land_timeout_s) + 5
-                                   : options.rpc_timeout_ms / 1000.0;
-    c->expires = clock.now() + contracts::from_seconds(life_s);
-    const auto id = next_id++;
-    const auto bytes = airsim::encode_request(id, method, [&](Packer& p) { params(p); });
-    calls[id] = c;
-    boost::system::error_code ec;
-    asio::write(socket, asio::buffer(bytes), ec);
-    if (!ec) ++stats.requests;
-    if (ec) {
-      calls.erase(id);
-      lost_socket_locked("cannot send to AirSim at " + where() + ": " + ec.message());
-      return nullptr;
-    }
-    return c;
-  }
-
-  // Calls and waits up to `wait`; the Call (done or not), or nullptr when nothing was sent.
-  std::shared_ptr<Call> wait_locked(std::unique_lock<std::mutex>& lock, const std::string& method,
-                                    const std::function<void(Packer&)>& params,
-                                    std::chrono::milliseconds wait, bool deferred) {
-    auto c = call_locked(method, params, false);
-    if (!c) return nullptr;
-    cv.wait_for(lock, wait, [&] { return c->done; });
-    if (!c->done) {
-      if (deferred) {
-        c->deferred = true;
-        c->expires = clock.now() + contracts::from_seconds(options.land_timeout_s + 5);
-      }
-    }
-    return c;
-  }
-
   Result guard(const char* what) {
     if (!connected) {
       last_error = std::string(what) + ": not connected (call connect first)";
@@ -337,34 +126,6 @@ struct AirSimAdapter::Impl {
       last_error = std::string(what) + ": link lost (AirSim at " + where() +
                    (socket_up ? " does not answer)" : " is not connected; reconnecting)");
       return Result::kNotConnected;
-    }
-    return Result::kOk;
-  }
-
-  // An error, `false` or no answer from a call that must succeed at once.
-  Result check(const std::shared_ptr<Call>& c, const std::string& what, bool want_true) {
-    if (!c) {
-      last_error = what + ": not sent (" + last_error + ")";
-      return Result::kNotConnected;
-    }
-    if (!c->done) {
-      last_error = what + ": no answer from AirSim at " + where() + " in " +
-                   std::to_string(options.rpc_timeout_ms) + " ms";
-      return Result::kTimeout;
-    }
-    if (!c->answered) {
-      last_error = what + ": " + (c->error.empty() ? "no answer from AirSim" : c->error) +
-                   " (AirSim at " + where() + ")";
-      return c->error.empty() ? Result::kTimeout : Result::kNotConnected;
-    }
-    if (!c->ok) {
-      last_error = what + ": AirSim answered: " + c->error;
-      return Result::kRejected;
-    }
-    const auto& r = c->result.get();
-    if (want_true && !(r.type == msgpack::type::BOOLEAN && r.via.boolean)) {
-      last_error = what + ": AirSim answered " + airsim::describe(r);
-      return Result::kRejected;
     }
     return Result::kOk;
   }
@@ -394,35 +155,15 @@ struct AirSimAdapter::Impl {
 
   // ---- the clock's timers -----------------------------------------------------------------
 
-  void schedule_tick() {
-    tick_timer.expires_after(kTickPeriod);
-    tick_timer.async_wait([this](boost::system::error_code ec) {
-      if (ec) return;
-      tick();
-      schedule_tick();
-    });
-  }
-
-  void tick() {
+  void tick() override {
     std::vector<contracts::TelemetryFrame> frames;
     control::TelemetrySink to;
     {
       std::lock_guard lock(mutex);
-      // Calls nobody waits for any more expire on the injected clock (simulated time in a
-      // lockstep run); the blocking waits themselves are real time (a socket's).
-      const auto expire_before = clock.now();
-      for (auto it = calls.begin(); it != calls.end();) {
-        if (it->second->expires < expire_before) {
-          it->second->done = true;
-          it = calls.erase(it);
-        } else {
-          ++it;
-        }
-      }
-      stats.outstanding = calls.size();
+      expire_calls_locked();
       if (!connected) return;
       const auto now = clock.now();
-      if (!socket_up && !dialing && now >= reconnect_at) dial();
+      redial_if_due_locked(now);
       const double since =
           contracts::to_seconds(now - (have_state ? last_state_at : connected_at));
       if (!link_lost && since > options.link_timeout_s) {
@@ -466,38 +207,9 @@ struct AirSimAdapter::Impl {
         }
       }
     }
-    if (to && !frames.empty()) {
-      std::lock_guard order(sink_mutex);
-      for (const auto& f : frames) to(f);
-    }
+    deliver(frames, to);
   }
 
-  const contracts::Clock& clock;
-  AirSimOptions options;
-  asio::io_context io;
-  tcp::socket socket;
-  asio::steady_timer tick_timer;
-  tcp::endpoint server;
-  std::array<char, 65536> read_buffer{};
-  std::thread io_thread;
-
-  mutable std::mutex mutex;
-  std::condition_variable cv;
-  std::mutex sink_mutex;
-  std::mutex command_mutex;
-  control::TelemetrySink sink;
-  std::unique_ptr<msgpack::unpacker> unpacker;
-  std::map<std::uint32_t, std::shared_ptr<Call>> calls;
-  std::uint32_t next_id = 1;
-
-  bool socket_up = false;
-  bool dialing = false;
-  std::uint64_t dial_generation = 0;
-  std::string dial_error;
-  double backoff_s = 0.5;
-  contracts::Duration reconnect_at{0};
-
-  bool connected = false;
   bool link_lost = false;
   FlightState flight = FlightState::kInit;
   bool flown = false;
@@ -511,8 +223,7 @@ struct AirSimAdapter::Impl {
   bool origin_set = false;
   airsim::Vector3 origin;
   double origin_yaw_deg = 0;
-  std::string last_error;
-  AirSimStats stats;
+  std::mutex command_mutex;  // one command call at a time (emergency jumps the queue)
 };
 
 // ---- the adapter --------------------------------------------------------------------------

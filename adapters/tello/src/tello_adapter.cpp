@@ -1,34 +1,31 @@
 #include "gbdcs/adapters/tello_adapter.hpp"
 
 #include <algorithm>
-#include <boost/asio.hpp>
 #include <chrono>
 #include <cmath>
-#include <condition_variable>
-#include <deque>
 #include <mutex>
 #include <numbers>
 #include <optional>
-#include <stdexcept>
-#include <thread>
+#include <vector>
 
 #include "gbdcs/adapters/tello_state.hpp"
+#include "tello_link.hpp"
+
+// The DroneAdapter mapping: flight states, the rc stream, telemetry from the state stream and
+// the link watchdog. The sockets and the reply matching are TelloLink's (tello_link.hpp).
 
 namespace gbdcs::adapters {
 
-namespace asio = boost::asio;
-using asio::ip::udp;
 using contracts::FlightState;
 using control::Result;
+using detail::is_error_reply;
 
 namespace {
 
 constexpr double kDegToRad = std::numbers::pi / 180.0;
-constexpr auto kTickPeriod = std::chrono::milliseconds(10);
 constexpr int kStopBurst = 3;         // rc 0 0 0 0 sent this many times when the sticks centre
 constexpr double kLandSettleS = 0.5;  // at ground height this long: landed
 constexpr double kAutoLandSettleS = 1.0;
-constexpr double kDeferredReplyS = 20;  // take-off/land replies come within this (clock)
 
 double wrap_deg(double deg) {
   double w = std::fmod(deg, 360.0);
@@ -41,138 +38,28 @@ int stick(double value, double maximum) {
   return static_cast<int>(std::clamp(std::round(100.0 * value / maximum), -100.0, 100.0));
 }
 
-std::string trim(std::string s) {
-  while (!s.empty() && (s.back() == '\r' || s.back() == '\n' || s.back() == ' ' ||
-                        s.back() == '\0')) {
-    s.pop_back();
-  }
-  return s;
-}
-
-bool is_error_reply(const std::string& reply) {
-  return reply.rfind("error", 0) == 0 || reply.rfind("Error", 0) == 0 ||
-         reply.rfind("unknown command", 0) == 0 || reply.rfind("out of range", 0) == 0;
-}
-
 }  // namespace
 
-struct TelloAdapter::Impl {
-  struct Pending {
-    std::string command;
-    bool done = false;      // answered, expired or abandoned: nobody waits any more
-    bool answered = false;  // `reply` holds the drone's answer
-    bool deferred = false;  // the caller stopped waiting (take-off/land): outcome logged only
-    std::string reply;
-    contracts::Duration expires{0};  // on the injected clock
-  };
+struct TelloAdapter::Impl final : detail::TelloLink {
+  Impl(const contracts::Clock& c, TelloOptions o) : TelloLink(c, std::move(o)) { start(); }
+  ~Impl() override { stop(); }
 
-  Impl(const contracts::Clock& c, TelloOptions o)
-      : clock(c),
-        options(std::move(o)),
-        command_socket(io),
-        state_socket(io),
-        tick_timer(io) {
-    boost::system::error_code ec;
-    const auto drone_address = asio::ip::make_address(options.address, ec);
-    if (ec) {
-      throw std::invalid_argument(options.name + " options: 'address' '" + options.address +
-                                  "' is not an IP address (the " + options.drone_label +
-                                  "'s is usually 192.168.10.1)");
-    }
-    drone = udp::endpoint(drone_address, static_cast<unsigned short>(options.command_port));
-    const auto bind_address = asio::ip::make_address(options.bind_address, ec);
-    if (ec) {
-      throw std::invalid_argument(options.name + " options: 'bind_address' '" +
-                                  options.bind_address + "' is not an IP address");
-    }
-    open_bound(command_socket, udp::endpoint(bind_address, static_cast<unsigned short>(
-                                                               options.local_command_port)),
-               "command", "local_command_port");
-    open_bound(state_socket,
-               udp::endpoint(bind_address, static_cast<unsigned short>(options.state_port)),
-               "state", "state_port");
-    receive_reply();
-    receive_state();
-    schedule_tick();
-    io_thread = std::thread([this] { io.run(); });
-  }
+  // ---- link hooks (I/O thread) ------------------------------------------------------------
 
-  ~Impl() {
-    io.stop();
-    if (io_thread.joinable()) io_thread.join();
-  }
-
-  void open_bound(udp::socket& socket, const udp::endpoint& at, const char* what,
-                  const char* key) {
-    boost::system::error_code ec;
-    socket.open(at.protocol(), ec);
-    if (!ec) socket.set_option(udp::socket::reuse_address(false), ec);
-    if (!ec) socket.bind(at, ec);
-    if (ec) {
-      throw std::runtime_error(options.name + ": cannot bind the " + what + " socket to " +
-                               at.address().to_string() + ":" + std::to_string(at.port()) + ": " +
-                               ec.message() +
-                               " (another Tello client or gbdcs running? stop it, or set '" +
-                               key + "' in the options to another port, 0 for any free one)");
-    }
-  }
-
-  // ---- I/O thread -------------------------------------------------------------------------
-
-  void receive_reply() {
-    command_socket.async_receive_from(
-        asio::buffer(reply_buffer), reply_from, [this](boost::system::error_code ec, std::size_t n) {
-          if (ec == asio::error::operation_aborted) return;
-          if (!ec) on_reply(std::string(reply_buffer.data(), n));
-          receive_reply();
-        });
-  }
-
-  void receive_state() {
-    state_socket.async_receive_from(
-        asio::buffer(state_buffer), state_from, [this](boost::system::error_code ec, std::size_t n) {
-          if (ec == asio::error::operation_aborted) return;
-          if (!ec) on_state(std::string_view(state_buffer.data(), n));
-          receive_state();
-        });
-  }
-
-  void schedule_tick() {
-    tick_timer.expires_after(kTickPeriod);
-    tick_timer.async_wait([this](boost::system::error_code ec) {
-      if (ec) return;
-      tick();
-      schedule_tick();
-    });
-  }
-
-  void on_reply(std::string text) {
-    text = trim(std::move(text));
-    std::lock_guard lock(mutex);
-    ++stats.replies;
-    if (pending.empty()) {
-      ++stats.unexpected_replies;
-      return;
-    }
-    auto p = pending.front();
-    pending.pop_front();
-    p->reply = text;
-    p->answered = true;
-    p->done = true;
-    if (p->deferred && is_error_reply(text)) {
-      last_error = p->command + ": the " + options.drone_label + " answered '" + text +
+  void on_late_reply_locked(const Pending& p) override {
+    if (is_error_reply(p.reply)) {
+      last_error = p.command + ": the " + options.drone_label + " answered '" + p.reply +
                    "' after accepting it";
-      if (p->command == options.words.takeoff && flight == FlightState::kFlying && !climbed) {
+      if (p.command == options.words.takeoff && flight == FlightState::kFlying && !climbed) {
         flight = FlightState::kReady;  // it never left the ground
       }
     }
-    if (p->deferred && !is_error_reply(text) && p->command == options.words.takeoff) {
+    if (!is_error_reply(p.reply) && p.command == options.words.takeoff) {
       climbed = true;  // the take-off is complete
     }
-    reply_cv.notify_all();
   }
 
-  void on_state(std::string_view datagram) {
+  void on_state_datagram(std::string_view datagram) override {
     std::string why;
     auto decoded = decode_state(datagram, why);
     std::vector<contracts::TelemetryFrame> frames;
@@ -277,62 +164,6 @@ struct TelloAdapter::Impl {
 
   // ---- sending ----------------------------------------------------------------------------
 
-  std::shared_ptr<Pending> send_locked(const std::string& text, bool expect_reply) {
-    std::shared_ptr<Pending> p;
-    if (expect_reply) {
-      p = std::make_shared<Pending>();
-      p->command = text;
-      p->expires = clock.now() + contracts::from_seconds(options.reply_timeout_ms / 1000.0);
-      pending.push_back(p);
-    }
-    boost::system::error_code ec;
-    command_socket.send_to(asio::buffer(text), drone, 0, ec);
-    ++stats.commands_sent;
-    last_sent_at = clock.now();
-    if (ec) {
-      last_error = "cannot send '" + text + "' to " + endpoint_text() + ": " + ec.message() +
-                   " (" + fix_text() + ")";
-      if (p) {
-        pending.pop_back();
-        p->done = true;
-        p->reply.clear();
-      }
-    }
-    return p;
-  }
-
-  // Sends and waits up to `wait` for the reply; nullopt on no reply. `deferred`: a reply
-  // that comes later is still consumed (and an error logged) instead of being abandoned.
-  std::optional<std::string> request_locked(std::unique_lock<std::mutex>& lock,
-                                            const std::string& text,
-                                            std::chrono::milliseconds wait, bool deferred) {
-    send_failed = false;
-    auto p = send_locked(text, true);
-    if (!p || p->done) {
-      send_failed = true;
-      return std::nullopt;
-    }
-    reply_cv.wait_for(lock, wait, [&] { return p->done; });
-    if (p->answered) return p->reply;
-    if (p->done) return std::nullopt;  // expired or abandoned (an emergency cleared it)
-    if (deferred) {
-      p->deferred = true;
-      p->expires = clock.now() + contracts::from_seconds(kDeferredReplyS);
-    } else {
-      abandon_locked(p);
-    }
-    return std::nullopt;
-  }
-
-  void abandon_locked(const std::shared_ptr<Pending>& p) {
-    auto it = std::find(pending.begin(), pending.end(), p);
-    if (it != pending.end()) pending.erase(it);
-  }
-
-  bool long_command_pending_locked() const {
-    return std::any_of(pending.begin(), pending.end(), [](const auto& p) { return p->deferred; });
-  }
-
   void send_rc_locked(const std::array<int, 4>& s) {
     send_locked(options.words.rc + " " + std::to_string(s[0]) + " " + std::to_string(s[1]) + " " +
                     std::to_string(s[2]) + " " + std::to_string(s[3]),
@@ -345,17 +176,6 @@ struct TelloAdapter::Impl {
     sticks = {0, 0, 0, 0};
     stop_at.reset();
     if (were_moving) stop_burst = kStopBurst;
-  }
-
-  std::string endpoint_text() const {
-    return options.address + ":" + std::to_string(options.command_port);
-  }
-
-  std::string fix_text() const {
-    return "join " + options.wifi_hint + ", check that the " + options.drone_label +
-           " is on and that 'address' (" + options.address + ") and 'command_port' (" +
-           std::to_string(options.command_port) + ") in the " + options.name +
-           " options are right";
   }
 
   // The common checks: connected and the link up.
@@ -374,19 +194,14 @@ struct TelloAdapter::Impl {
 
   // ---- the clock's timers -----------------------------------------------------------------
 
-  void tick() {
+  void tick() override {
     std::vector<contracts::TelemetryFrame> frames;
     control::TelemetrySink to;
     {
       std::lock_guard lock(mutex);
-      // Replies nobody waits for (keep-alive, take-off/land) expire on the injected clock,
-      // so a lockstep run gives a lost one up after the same simulated time as a real flight.
-      const auto now = clock.now();
-      while (!pending.empty() && pending.front()->expires < now) {
-        pending.front()->done = true;  // never answered: lost
-        pending.pop_front();
-      }
+      expire_pending_locked();
       if (!connected) return;
+      const auto now = clock.now();
       const double since_state =
           contracts::to_seconds(now - (have_state ? last_state_at : connected_at));
       if (!link_lost && since_state > options.link_timeout_s) {
@@ -397,9 +212,9 @@ struct TelloAdapter::Impl {
                                std::to_string(static_cast<int>(since_state * 10) / 10.0).substr(0, 4) +
                                " s (out of Wi-Fi range, or its battery died?)"
                          : "no state datagrams on local UDP port " +
-                               std::to_string(state_socket.local_endpoint().port()) +
+                               std::to_string(local_state_port()) +
                                " since connect: let UDP " +
-                               std::to_string(state_socket.local_endpoint().port()) +
+                               std::to_string(local_state_port()) +
                                " in through the firewall, or check 'state_port' in the " +
                                options.name + " options";
         frames.push_back(frame_locked(contracts::LinkState::kLost));
@@ -424,21 +239,6 @@ struct TelloAdapter::Impl {
     deliver(frames, to);
   }
 
-  const contracts::Clock& clock;
-  TelloOptions options;
-  asio::io_context io;
-  udp::socket command_socket;
-  udp::socket state_socket;
-  asio::steady_timer tick_timer;
-  udp::endpoint drone;
-  udp::endpoint reply_from, state_from;
-  std::array<char, 2048> reply_buffer{};
-  std::array<char, 4096> state_buffer{};
-  std::thread io_thread;
-
-  mutable std::mutex mutex;
-  std::condition_variable reply_cv;
-  std::deque<std::shared_ptr<Pending>> pending;
   control::TelemetrySink sink;
   std::mutex sink_mutex;
   std::mutex command_mutex;  // one command call at a time (emergency jumps the queue)
@@ -446,14 +246,12 @@ struct TelloAdapter::Impl {
   bool connected = false;
   bool link_lost = false;
   bool stop_unsupported = false;
-  bool send_failed = false;  // the last request_locked() could not send
   FlightState flight = FlightState::kInit;
   bool climbed = false;
   std::array<int, 4> sticks{0, 0, 0, 0};
   int stop_burst = 0;
   std::optional<contracts::Duration> stop_at;
   contracts::Duration rc_next_at{0};
-  contracts::Duration last_sent_at{0};
   contracts::Duration connected_at{0};
   contracts::Duration last_state_at{0};
   std::optional<contracts::Duration> ground_since;
@@ -462,8 +260,6 @@ struct TelloAdapter::Impl {
   double origin_yaw_deg = 0;
   double x_m = 0, y_m = 0, body_vx = 0, body_vy = 0, vz = 0, heading_deg = 0;
   double height_cm = 0, battery_pct = 100;
-  std::string last_error;
-  TelloStats stats;
 };
 
 // ---- the adapter --------------------------------------------------------------------------
@@ -478,11 +274,11 @@ std::string_view TelloAdapter::name() const { return impl_->options.name; }
 const TelloOptions& TelloAdapter::options() const { return impl_->options; }
 
 std::uint16_t TelloAdapter::local_state_port() const {
-  return impl_->state_socket.local_endpoint().port();
+  return impl_->local_state_port();
 }
 
 std::uint16_t TelloAdapter::local_command_port() const {
-  return impl_->command_socket.local_endpoint().port();
+  return impl_->local_command_port();
 }
 
 TelloStats TelloAdapter::stats() const {
@@ -653,9 +449,7 @@ Result TelloAdapter::emergency_stop() {
     d.last_error = "emergency: not connected";
     return Result::kNotConnected;
   }
-  for (auto& p : d.pending) p->done = true;  // their replies can no longer be told apart
-  d.pending.clear();
-  d.reply_cv.notify_all();
+  d.abandon_all_locked();  // their replies can no longer be told apart
   d.sticks = {0, 0, 0, 0};
   d.stop_at.reset();
   d.stop_burst = 0;
