@@ -8,6 +8,9 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <mutex>
+#include <utility>
+#include <vector>
 #include <boost/asio.hpp>
 #include <filesystem>
 #include <unistd.h>
@@ -59,6 +62,31 @@ sim::AirSimEmulatorOptions airsim_emulator_options() {
   return o;
 }
 
+// Every command the service's loops report, with its outcome.
+class CommandLog final : public runtime::EventListener {
+ public:
+  void on_command(const contracts::DroneCommand& c, const std::string& outcome) override {
+    std::lock_guard lock(mutex_);
+    log_.emplace_back(c, outcome);
+  }
+  // The outcome of the last command of this type from this source id, or "" if none yet.
+  std::string outcome_of(CommandType type, const std::string& source_id) const {
+    std::lock_guard lock(mutex_);
+    for (auto it = log_.rbegin(); it != log_.rend(); ++it) {
+      if (it->first.type == type && it->first.source_id == source_id) return it->second;
+    }
+    return {};
+  }
+  std::size_t size() const {
+    std::lock_guard lock(mutex_);
+    return log_.size();
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  std::vector<std::pair<contracts::DroneCommand, std::string>> log_;
+};
+
 // Two physical drones (two twins, each behind its emulator) and the server's drone service.
 class SwapRig {
  public:
@@ -73,6 +101,7 @@ class SwapRig {
         clock, storage, hub,
         [this](const std::string& name, const json&) { return make(name); },
         control::GestureProfile::builtin_default(), nullptr);
+    service->add_listener(commands);
   }
   ~SwapRig() { service.reset(); }
 
@@ -96,13 +125,17 @@ class SwapRig {
   }
 
   // One step of simulated time: both twins move, the camera shows no hand (vision alive),
-  // and the current adapter's traffic settles (real time, bounded).
+  // the current adapter's timers run, and its traffic settles (real time, bounded).
   void step() {
     clock.advance(std::chrono::milliseconds(50));
     tello_host.poll();
     airsim_host.poll();
     json frame = {{"type", "frame"}, {"frame_id", ++frame_id}, {"hands", json::array()}};
     service->on_vision_frame(frame);
+    // The adapter's timers at the new time (its state poll, rc stream, keep-alive), as the
+    // runner's tick would; the service's own tick thread runs in real time besides.
+    if (auto* t = tello.load()) t->poll();
+    if (auto* s = airsim.load()) s->poll();
     bool ok = true;
     if (auto* t = tello.load()) {
       ok = await([&] {
@@ -130,15 +163,21 @@ class SwapRig {
     }
     return done();
   }
+  // Submits as the API does and waits (real time, bounded) until the service's own tick
+  // thread has dispatched it, so simulated time never runs ahead of a pending command.
   control::Decision submit(CommandType type, contracts::MotionPayload motion = {}) {
     contracts::DroneCommand c;
     c.type = type;
     c.source = CommandSource::kApi;
-    c.source_id = "swap_test";
+    c.source_id = "swap_test_" + std::to_string(++submitted);
     if (type == CommandType::kMove) c.payload = motion;
     c.issued_at = clock.utc_now();
     auto d = service->submit(c);
-    return d ? *d : control::Decision{};
+    if (!d || !d->accepted) return d ? *d : control::Decision{};
+    EXPECT_TRUE(await([&] { return !commands->outcome_of(type, c.source_id).empty(); }))
+        << "the service never dispatched " << contracts::to_string(type);
+    EXPECT_EQ(commands->outcome_of(type, c.source_id), "OK");
+    return *d;
   }
 
   void send_marker_to_tello_emulator() {
@@ -167,6 +206,8 @@ class SwapRig {
   std::atomic<TelloAdapter*> tello{nullptr};
   std::atomic<AirSimAdapter*> airsim{nullptr};
   std::int64_t frame_id = 0;
+  int submitted = 0;
+  std::shared_ptr<CommandLog> commands = std::make_shared<CommandLog>();
 };
 
 TEST(AdapterSwap, TelloToAirSimLandsTheOldAndStartsTheNewIdle) {
