@@ -231,7 +231,7 @@ void add_serve_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--source", o.source,
                   "Camera for the vision worker: camera:N, video:PATH, recipe:PATH[?live=1], "
-                  "timeline:PATH")
+                  "timeline:PATH, tello:[ADDRESS][?...] (the drone's own camera)")
       ->capture_default_str();
   cmd->add_option("--config", o.config, "JSON file with any of these options (the command line wins)");
   cmd->add_option("--web", o.web, "The built dashboard")->capture_default_str();

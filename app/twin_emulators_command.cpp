@@ -17,6 +17,7 @@
 #include "commands.hpp"
 #include "gbdcs/sim/airsim_emulator.hpp"
 #include "gbdcs/sim/tello_emulator.hpp"
+#include "gbdcs/sim/tello_video_streamer.hpp"
 #include "gbdcs/sim/twin_host.hpp"
 #include "twin_emulators.hpp"
 
@@ -28,6 +29,11 @@ struct EmulatorCmdOptions {
   int tello_port = 8889;
   int tello_state_port = 8890;
   std::string tello_sdk = "2.0";
+  bool tello_no_video = false;
+  int tello_video_port = 11111;
+  std::string tello_video_camera = "onboard";
+  double tello_video_fps = 15;
+  int tello_video_width = 480;
   bool airsim = false;
   int airsim_port = 41451;
   std::string airsim_vehicle = "Drone1";
@@ -63,6 +69,25 @@ void add_twin_emulator_options(CLI::App* twin) {
   twin->add_option("--tello-sdk", o.tello_sdk, "Tello SDK the emulator speaks")
       ->capture_default_str()
       ->check(CLI::IsMember({"2.0", "1.3"}));
+  twin->add_flag("--tello-no-video", o.tello_no_video,
+                 "Answer streamon/streamoff with ok but send no video (saves the rendering)");
+  twin->add_option("--tello-video-port", o.tello_video_port,
+                   "The client's UDP port the H.264 video goes to after streamon (a Tello's: "
+                   "11111)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 65535));
+  twin->add_option("--tello-video-camera", o.tello_video_camera,
+                   "The twin's camera in the video: onboard (the Tello's front camera) or chase")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"onboard", "chase", "overview"}));
+  twin->add_option("--tello-video-fps", o.tello_video_fps,
+                   "Video frame rate (a real Tello: 30; rendering on the CPU: keep it modest)")
+      ->capture_default_str()
+      ->check(CLI::Range(1.0, 60.0));
+  twin->add_option("--tello-video-size", o.tello_video_width,
+                   "Video width; the height is 3/4 of it (a real Tello: 960x720)")
+      ->capture_default_str()
+      ->check(CLI::Range(64, 1920));
   twin->add_flag("--airsim", o.airsim,
                  "Serve the twin as an AirSim multirotor (msgpack-RPC over TCP) in real time");
   twin->add_option("--airsim-port", o.airsim_port, "TCP port of the AirSim RPC (0: any)")
@@ -107,6 +132,7 @@ int run_twin_emulators() {
   sim::TwinHost host(clock, std::make_shared<const sim::TwinModel>(), host_options);
 
   std::optional<sim::TelloEmulator> tello;
+  std::optional<sim::TelloVideoStreamer> tello_video;  // destroyed before the emulator
   if (o.tello) {
     sim::TelloEmulatorOptions t;
     t.bind_address = o.bind;
@@ -117,6 +143,19 @@ int run_twin_emulators() {
     std::cerr << "gbdcs twin: Tello SDK " << o.tello_sdk << " on udp://" << o.bind << ":"
               << tello->port() << " (state to the client's port " << o.tello_state_port
               << ")\n";
+    if (!o.tello_no_video) {
+      sim::TelloVideoStreamOptions v;
+      v.client_port = o.tello_video_port;
+      v.camera = o.tello_video_camera;
+      v.fps = o.tello_video_fps;
+      v.width = o.tello_video_width / 2 * 2;
+      v.height = o.tello_video_width * 3 / 4 / 2 * 2;
+      tello_video.emplace(host, v);
+      tello_video->attach(*tello);
+      std::cerr << "gbdcs twin: Tello video after streamon: H.264 " << v.width << "x" << v.height
+                << " at " << v.fps << " fps of the " << v.camera
+                << " camera to the client's UDP port " << v.client_port << "\n";
+    }
   }
   std::optional<sim::AirSimEmulator> airsim;
   if (o.airsim) {
@@ -168,6 +207,10 @@ int run_twin_emulators() {
         const auto st = tello->stats();
         std::cerr << "; tello " << st.datagrams << " datagrams, " << st.state_packets
                   << " states";
+      }
+      if (tello_video && tello_video->streaming()) {
+        const auto st = tello_video->stats();
+        std::cerr << "; video " << st.frames << " frames, " << st.datagrams << " datagrams";
       }
       if (airsim) {
         const auto st = airsim->stats();

@@ -306,7 +306,7 @@ void add_vision_commands(CLI::App& app) {
       "vision",
       "Run the vision pipeline (capture -> landmarks -> gesture) on a camera, video or image "
       "folder; prints JSON lines: a frame message per frame, a heartbeat every second");
-  vision_cmd->add_option("--source", v.source, "camera:N, video:PATH, images:DIR or recipe:PATH[?live=1]")->required();
+  vision_cmd->add_option("--source", v.source, "camera:N, video:PATH, images:DIR, recipe:PATH[?live=1] or tello:[ADDRESS][?...] (a Tello's own camera; docs/ADAPTERS.md)")->required();
   add_model_options(vision_cmd, v.models);
   vision_cmd->add_option("--publish", v.publish,
                          "Send the messages to a WebSocket instead of stdout: "

@@ -272,7 +272,10 @@ struct TelloEmulator::Impl {
       if (verb == "wifi?") return reply_locked("90");
       if (verb == "sdk?" && options.sdk == "2.0") return reply_locked("20");
       if (verb == "sn?") return reply_locked("0TQZGBDCSTWIN1");
-      if (verb == "streamon" || verb == "streamoff") return reply_locked("ok");
+      if (verb == "streamon" || verb == "streamoff") {
+        if (stream_handler) stream_handler(verb == "streamon", client.address().to_string());
+        return reply_locked("ok");
+      }
     }
     if (verb == "speed" && words.size() == 2) {
       const auto v = to_int(words[1]);
@@ -375,6 +378,7 @@ struct TelloEmulator::Impl {
   double motor_time_s = 0;
   double last_step_s = -1;
   int speed_cm_s = 100;
+  StreamHandler stream_handler;
   TelloEmulatorStats stats;
 };
 
@@ -393,6 +397,11 @@ void TelloEmulator::set_state_port(int port) {
 void TelloEmulator::set_link_lost(bool lost) {
   std::lock_guard lock(impl_->mutex);
   impl_->link_lost = lost;
+}
+
+void TelloEmulator::set_stream_handler(StreamHandler handler) {
+  std::lock_guard lock(impl_->mutex);
+  impl_->stream_handler = std::move(handler);
 }
 
 TelloEmulatorStats TelloEmulator::stats() const {

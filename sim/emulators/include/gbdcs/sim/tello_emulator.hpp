@@ -14,7 +14,9 @@
 //   rc a b c d       no reply; each -100...100 (a right, b forward, c up, d yaw clockwise)
 //   speed x          "ok" for 10...100 cm/s (kept for speed?; the twin's rc maxima stay)
 //   battery? speed? time? height? temp? attitude? baro? tof? wifi? sdk? sn?   their values
-//   streamon/streamoff  "ok" (no video: the twin renders through `gbdcs twin --record`)
+//   streamon/streamoff  "ok"; with a stream handler (sim/tello_video's TelloVideoStreamer,
+//                    `gbdcs twin --tello`) the twin's camera then streams as H.264 to the
+//                    client's UDP 11111, as a Tello's
 //   anything else    "unknown command: <text>"; moves by distance (up/forward/cw x ...) are
 //                    "error Not supported by the twin's Tello emulator"
 //   A reply-expecting command that arrives while take-off/land is still pending first
@@ -29,6 +31,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -80,6 +83,12 @@ class TelloEmulator {
   void set_state_port(int port);
   void set_link_lost(bool lost);
   TelloEmulatorStats stats() const;
+
+  // streamon / streamoff from the client (in SDK mode): handler(true, the client's IP
+  // address) / handler(false, ...), called on the emulator's I/O thread with its lock held
+  // (keep it short). Without a handler both are only answered "ok".
+  using StreamHandler = std::function<void(bool on, const std::string& client_address)>;
+  void set_stream_handler(StreamHandler handler);
 
   struct Impl;
 
