@@ -48,13 +48,38 @@ std::string env(const char* name, const std::string& fallback = {}) {
   return v ? std::string(v) : fallback;
 }
 
+// A whole-number setting from the environment, checked: a bad value names the variable, what
+// it must be and where it is documented, instead of a bare "stoi".
+long long env_int(const char* name, long long fallback, long long min, long long max) {
+  const std::string text = env(name);
+  if (text.empty()) return fallback;
+  std::size_t used = 0;
+  long long value = 0;
+  try {
+    value = std::stoll(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != text.size() || value < min || value > max) {
+    throw std::runtime_error(std::string(name) + "='" + text.substr(0, 40) +
+                             "' is not valid: set a whole number from " + std::to_string(min) +
+                             " to " + std::to_string(max) + " or unset it (see .env.example)");
+  }
+  return value;
+}
+
 // --config FILE: the same settings as the options, as JSON; options on the command line win.
 void apply_config_file(ServeOptions& o, const CLI::App& cmd) {
   std::ifstream in(o.config);
   if (!in) throw std::runtime_error("--config " + o.config + ": cannot read (check the path)");
   std::stringstream text;
   text << in.rdbuf();
-  json doc = contracts::parse_json(text.str());
+  json doc;
+  try {
+    doc = contracts::parse_json(text.str());
+  } catch (const std::exception& e) {
+    throw std::runtime_error("--config " + o.config + ": " + e.what() + " (fix the JSON)");
+  }
   if (!doc.is_object()) throw std::runtime_error("--config " + o.config + ": must be a JSON object");
   for (const auto& [key, value] : doc.items()) {
     const bool given = cmd.count("--" + key) > 0;
@@ -78,6 +103,9 @@ void apply_config_file(ServeOptions& o, const CLI::App& cmd) {
 int run_serve(ServeOptions o) {
   contracts::SteadyClock clock;
   auto log = server::make_event_log(clock, o.log_json);
+  // A file-size limit (ulimit -f) must fail the write (EFBIG, reported like a full disk), not
+  // kill the server in mid-flight with SIGXFSZ. The vision worker inherits this.
+  std::signal(SIGXFSZ, SIG_IGN);
 
   std::string secret = env("GBDCS_JWT_SECRET");
   if (secret.empty()) {
@@ -87,12 +115,15 @@ int run_serve(ServeOptions o) {
                            "and die with this process"},
                  {"suggestion", "set GBDCS_JWT_SECRET (e.g. `openssl rand -hex 32`), see .env.example"}});
   }
-  server::TokenService tokens(clock, secret, std::stoi(env("GBDCS_TOKEN_TTL_S", "1800")));
+  server::TokenService tokens(clock, secret,
+                              static_cast<int>(env_int("GBDCS_TOKEN_TTL_S", 1800, 60, 1800)));
 
   storage::StorageOptions so;
   so.path = o.db;
   storage::StorageManager storage(so, clock);
-  storage.set_error_handler([&log](const std::string& e) { log("error", {{"event", "storage_error"}, {"cause", e}}); });
+  // Every failed write, for debugging; the operator-facing error (logged once per episode and
+  // every 10 s while it lasts, plus an alert) comes from DroneService's storage watch.
+  storage.set_error_handler([&log](const std::string& e) { log("debug", {{"event", "storage_error"}, {"cause", e}}); });
   storage.end_open_sessions();
   storage.apply_retention();
   storage.purge_revoked_tokens();
@@ -130,7 +161,8 @@ int run_serve(ServeOptions o) {
   so2.version = GBDCS_VERSION;
   so2.source = o.source;
   so2.adapters_available = drone_names();
-  so2.max_body_bytes = static_cast<std::size_t>(std::stoll(env("GBDCS_MAX_BODY_BYTES", "1048576")));
+  so2.max_body_bytes =
+      static_cast<std::size_t>(env_int("GBDCS_MAX_BODY_BYTES", 1048576, 1024, 64LL << 20));
   for (std::stringstream origins(env("GBDCS_ALLOWED_ORIGINS")); origins.good();) {
     std::string one;
     std::getline(origins, one, ',');

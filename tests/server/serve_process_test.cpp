@@ -9,77 +9,14 @@
 #include <cstdio>
 #include <fstream>
 
-#include "server_test_support.hpp"
+#include "serve_process_support.hpp"
 
 namespace gbdcs::server::testing {
 namespace {
 
-struct ServeProcess {
-  explicit ServeProcess(const std::string& db) {
-    int out[2];
-    if (pipe(out) != 0) throw std::runtime_error("pipe");
-    pid = fork();
-    if (pid == 0) {
-      dup2(out[1], 1);
-      close(out[0]);
-      const std::string bin = GBDCS_BINARY;
-      const std::string src = std::string("timeline:") + GBDCS_SOURCE_DIR + "/fixtures/timelines/demo_flight.json";
-      execl(bin.c_str(), bin.c_str(), "serve", "--port", "0", "--db", db.c_str(), "--adapter",
-            "dummy", "--source", src.c_str(), "--web", "/nonexistent", "--log-json",
-            "--worker-silence", "1", static_cast<char*>(nullptr));
-      _exit(127);
-    }
-    close(out[1]);
-    stream = fdopen(out[0], "r");
-    char line[4096];
-    while (fgets(line, sizeof line, stream)) {
-      const std::string s(line);
-      auto at = s.find("listening on http://127.0.0.1:");
-      if (at != std::string::npos) {
-        port = static_cast<unsigned short>(std::stoi(s.substr(at + 30)));
-        break;
-      }
-    }
-    // Keep draining the log so the server never blocks on a full pipe.
-    drain = std::thread([this] {
-      char buf[4096];
-      while (fgets(buf, sizeof buf, stream)) {
-      }
-    });
-  }
-  ~ServeProcess() {
-    kill(pid, SIGTERM);
-    waitpid(pid, nullptr, 0);
-    if (drain.joinable()) drain.join();
-    fclose(stream);
-  }
-  std::vector<pid_t> children() const {
-    std::vector<pid_t> out;
-    for (const auto& e : std::filesystem::directory_iterator("/proc")) {
-      const auto name = e.path().filename().string();
-      if (name.find_first_not_of("0123456789") != std::string::npos) continue;
-      std::ifstream stat(e.path() / "stat");
-      std::string text;
-      std::getline(stat, text);
-      auto close_paren = text.rfind(')');
-      if (close_paren == std::string::npos) continue;
-      std::istringstream rest(text.substr(close_paren + 2));
-      char state;
-      int ppid = 0;
-      rest >> state >> ppid;
-      if (ppid == pid && state != 'Z') out.push_back(std::stoi(name));
-    }
-    return out;
-  }
-  pid_t pid = -1;
-  FILE* stream = nullptr;
-  unsigned short port = 0;
-  std::thread drain;
-};
-
 TEST(ServeProcess, WorkerKilledMidFlightMeansHoverAlertAndRestart) {
   TempDir dir;
-  ServeProcess serve((dir.path() / "gbdcs.db").string());
+  ServeProcess serve((dir.path() / "gbdcs.db").string(), {"--adapter", "dummy"});
   ASSERT_GT(serve.port, 0);
   const json creds = {{"email", "pilot@example.com"}, {"password", "correct horse battery"}};
   ASSERT_EQ(http_call(serve.port, "POST", "/api/v1/auth/register", creds.dump()).status, 201);

@@ -1,6 +1,9 @@
 // /ws/live over real sockets: refusal without/with bad token and foreign Origin, the state on
 // connect, alerts and their ack, client message validation, logout and expiry closing the
 // socket, replay marked as such; the per-client queue's drop policy.
+#include <condition_variable>
+#include <mutex>
+
 #include "server_test_support.hpp"
 
 namespace gbdcs::server::testing {
@@ -138,6 +141,46 @@ OutMessagePtr msg(MessageClass cls, std::string text) {
   m->cls = cls;
   m->text = std::move(text);
   return m;
+}
+
+// The worker endpoint (worker -> server): only the per-run secret gets in; a message that is
+// not JSON or breaks its schema is logged and dropped, the socket stays up, and the next good
+// frame still reaches the server.
+TEST(ServerWorker, SecretRequiredAndBadMessagesAreDroppedNotFatal) {
+  const std::string secret(32, 'w');
+  ServerOptions o;
+  o.worker_secret = secret;
+  TestServer s(o);
+  std::mutex m;
+  std::vector<json> got;
+  std::condition_variable cv;
+  s.server->set_worker_handlers({nullptr,
+                                 [&](const json& doc) {
+                                   std::lock_guard lock(m);
+                                   got.push_back(doc);
+                                   cv.notify_all();
+                                 },
+                                 nullptr});
+  EXPECT_EQ(upgrade_status(s.port, "/worker"), 403);
+  EXPECT_EQ(upgrade_status(s.port, "/worker?secret=" + std::string(32, 'x')), 403);
+  EXPECT_EQ(upgrade_status(s.port, "/worker?secret=" + secret.substr(1)), 403);
+  WsClient worker;
+  worker.connect(s.port, "/worker?secret=" + secret);
+  const json good = {{"type", "frame"},  {"frame_id", 7},     {"capture_time", "2026-01-01T00:00:00.000Z"},
+                     {"source", "test"}, {"width", 640},      {"height", 480},
+                     {"latency_ms", 1.0}, {"hands", json::array()}, {"gesture_event", nullptr}};
+  worker.send("not json at all");
+  worker.send("{\"type\": \"frame\"}");
+  auto wrong_type = good;
+  wrong_type["frame_id"] = "seven";
+  worker.send(wrong_type.dump());
+  worker.send(json{{"type", "heartbeat"}, {"fps", "fast"}}.dump());
+  worker.send(json::array({1, 2, 3}).dump());
+  worker.send(good.dump());
+  std::unique_lock lock(m);
+  ASSERT_TRUE(cv.wait_for(lock, 10s, [&] { return !got.empty(); }));
+  ASSERT_EQ(got.size(), 1u) << "only the valid frame gets through";
+  EXPECT_EQ(got[0]["frame_id"], 7);
 }
 
 TEST(ClientQueue, DropsFramesThenTelemetryNeverAlerts) {

@@ -316,12 +316,23 @@ ApiResponse do_health(ApiContext& ctx) {
     db_ok = false;
   }
   auto drone = ctx.drone.state();
-  const bool good = db_ok && drone.value("connected", false);
+  const auto writes = ctx.storage.write_health();
+  const bool good = db_ok && writes.ok && drone.value("connected", false);
+  json db = {{"ok", db_ok},
+             {"path", ctx.storage.path()},
+             {"write_failures", ctx.storage.write_failures()},
+             {"writable", writes.ok}};
+  if (!writes.ok) {
+    db["disk_full"] = writes.disk_full;
+    db["error"] = writes.error;
+    db["suggestion"] = writes.suggestion.empty()
+                           ? "check the server log for the cause of the failing writes"
+                           : writes.suggestion;
+  }
   return ok({{"status", good ? "ok" : "degraded"},
              {"version", ctx.options.version},
              {"uptime_s", contracts::to_seconds(ctx.clock.now() - ctx.started)},
-             {"db", {{"ok", db_ok}, {"path", ctx.storage.path()},
-                     {"write_failures", ctx.storage.write_failures()}}},
+             {"db", db},
              {"drone", drone}});
 }
 

@@ -101,6 +101,18 @@ DroneService::~DroneService() {
   disconnect();
 }
 
+void DroneService::end_session_quietly(std::int64_t session) {
+  if (session == 0) return;
+  try {
+    storage_.end_session(session);
+  } catch (const std::exception& e) {
+    // Shutting down or swapping with a full disk: the row stays open and the next start's
+    // end_open_sessions() closes it at its last logged row.
+    if (log_) log_("warn", {{"event", "session_end_not_recorded"}, {"session_id", session},
+                            {"cause", e.what()}});
+  }
+}
+
 void DroneService::stop_active_locked() {
   if (!active_) return;
   auto& a = *active_;
@@ -116,7 +128,7 @@ void DroneService::stop_active_locked() {
   }
   a.loop->telemetry().drain(std::chrono::milliseconds(500));
   a.loop->stop();
-  storage_.end_session(a.session);
+  end_session_quietly(a.session);
   if (log_) log_("info", {{"event", "drone_disconnected"}, {"adapter", a.name},
                           {"session_id", a.session}});
   active_.reset();
@@ -141,7 +153,14 @@ std::string DroneService::connect(const std::string& name, const json& options) 
   a->translator = std::make_unique<control::CommandTranslator>(profile_);
   a->loop = std::make_unique<runtime::ControlLoop>(clock_, *a->adapter, *a->engine,
                                                    *a->translator, options_.loop);
-  a->session = storage_.begin_session(std::nullopt, name, profile_.name);
+  try {
+    a->session = storage_.begin_session(std::nullopt, name, profile_.name);
+  } catch (const std::exception& e) {
+    // A full disk must not ground the drone: fly unrecorded (session 0, every log_* fails and
+    // is counted; watch_storage raises the alert that says so).
+    a->session = 0;
+    if (log_) log_("error", {{"event", "session_not_recorded"}, {"cause", e.what()}});
+  }
   std::vector<std::shared_ptr<runtime::EventListener>> extra;
   {
     std::lock_guard s(status_mutex_);
@@ -151,7 +170,7 @@ std::string DroneService::connect(const std::string& name, const json& options) 
   const auto result = a->loop->start();
   if (result != control::Result::kOk) {
     const std::string why = std::string(control::to_string(result)) + " " + a->adapter->last_error();
-    storage_.end_session(a->session);
+    end_session_quietly(a->session);
     lock.unlock();
     publish_state();
     return "cannot connect to the '" + name + "' drone: " + why;
@@ -287,7 +306,7 @@ json DroneService::state() const {
     std::shared_lock lock(active_mutex_);
     j["adapter"] = adapter_name_;
     j["connected"] = active_ != nullptr;
-    j["session_id"] = active_ ? json(active_->session) : json(nullptr);
+    j["session_id"] = active_ && active_->session > 0 ? json(active_->session) : json(nullptr);
     auto t = active_ ? active_->loop->latest_telemetry() : std::nullopt;
     j["flight_state"] = std::string(contracts::to_string(
         t ? t->flight_state : (active_ ? active_->adapter->state() : contracts::FlightState::kInit)));
@@ -367,12 +386,58 @@ void DroneService::tick_loop() {
       if (active_) active_->loop->tick();
     }
     hub_.close_expired();
+    watch_storage();
     const auto now = clock_.now();
     if (now >= next_state) {
       publish_state();
       next_state = now + state_every;
     }
     std::this_thread::sleep_for(contracts::from_seconds(options_.tick_s));
+  }
+}
+
+void DroneService::watch_storage() {
+  const auto health = storage_.write_health();
+  const auto now = clock_.now();
+  if (health.episodes > storage_episodes_seen_) {
+    // A new failing episode (it may already be over: a single failed write counts too).
+    storage_episodes_seen_ = health.episodes;
+    storage_failing_ = true;
+    storage_next_log_ = now + std::chrono::seconds(10);
+    contracts::Alert a;
+    a.severity = contracts::Severity::kWarning;
+    a.code = health.disk_full ? "STORAGE_DISK_FULL" : "STORAGE_WRITE_FAILING";
+    a.cause = health.error.substr(0, 500);
+    a.suggestion = (health.suggestion.empty()
+                        ? std::string("check the server log for the cause; flying goes on, but "
+                                      "nothing is recorded until a write succeeds again")
+                        : health.suggestion)
+                       .substr(0, 500);
+    if (log_) {
+      log_("error", {{"event", "storage_failing"}, {"cause", health.error},
+                     {"suggestion", a.suggestion}, {"disk_full", health.disk_full}});
+    }
+    raise_alert(a);  // cannot be stored while writes fail: broadcast with id 0
+  } else if (storage_failing_ && !health.ok && now >= storage_next_log_) {
+    storage_next_log_ = now + std::chrono::seconds(10);
+    if (log_) {
+      log_("error", {{"event", "storage_still_failing"}, {"cause", health.error},
+                     {"failed_writes", health.episode_failures},
+                     {"suggestion", health.suggestion}});
+    }
+  }
+  if (storage_failing_ && health.ok) {
+    storage_failing_ = false;
+    contracts::Alert a;
+    a.severity = contracts::Severity::kInfo;
+    a.code = "STORAGE_RECOVERED";
+    a.cause = "database writes succeed again after " + std::to_string(health.episode_failures) +
+              " failed writes (those rows are missing from the record)";
+    a.suggestion = "nothing to do; keep an eye on free disk space";
+    if (log_) {
+      log_("info", {{"event", "storage_recovered"}, {"failed_writes", health.episode_failures}});
+    }
+    raise_alert(a);
   }
 }
 

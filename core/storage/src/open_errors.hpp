@@ -14,6 +14,14 @@ StorageError not_a_database_error(const std::string& path, const std::string& ca
 StorageError cannot_write_error(const std::string& path, const std::string& cause);
 StorageError open_error(const std::string& path, const SqliteError& e);
 
+// For a write that failed while running: whether it ran out of space, and the fix to tell
+// the operator (empty when there is nothing specific to do).
+struct WriteFailureKind {
+  bool disk_full = false;
+  std::string suggestion;
+};
+WriteFailureKind classify_write_failure(const std::string& path, const SqliteError& e);
+
 // Creates the folders above `path`; throws the matching StorageError when it cannot.
 void create_parent_directories(const std::string& path);
 

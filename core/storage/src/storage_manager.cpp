@@ -114,34 +114,78 @@ void StorageManager::open_connection() {
 WriteResult StorageManager::guarded_write(std::string_view what, std::int64_t session_id,
                                           const std::function<std::int64_t()>& write) {
   WriteResult result;
+  detail::WriteFailureKind kind;
   try {
     std::lock_guard lock(mutex_);
     result.row_id = write();
+  } catch (const detail::SqliteError& e) {
+    kind = detail::classify_write_failure(options_.path, e);
+    result.ok = false;
+    result.row_id = 0;
+    result.error = "cannot " + std::string(what) + " for session " + std::to_string(session_id) +
+                   " in " + options_.path + ": " + e.what() +
+                   (kind.suggestion.empty() ? "" : " (" + kind.suggestion + ")");
   } catch (const std::exception& e) {
     result.ok = false;
     result.row_id = 0;
     result.error = "cannot " + std::string(what) + " for session " + std::to_string(session_id) +
                    " in " + options_.path + ": " + e.what();
   }
-  if (!result.ok) report_failure(result.error);
+  if (!result.ok) {
+    report_failure(result.error, kind.suggestion, kind.disk_full);
+  } else {
+    note_write_ok();
+  }
   return result;
 }
 
 void StorageManager::checked_write(std::string_view what, const std::function<void()>& write) {
   std::string error;
+  detail::WriteFailureKind kind;
   try {
-    std::lock_guard lock(mutex_);
-    write();
+    {
+      std::lock_guard lock(mutex_);
+      write();
+    }
+    note_write_ok();
     return;
+  } catch (const detail::SqliteError& e) {
+    kind = detail::classify_write_failure(options_.path, e);
+    error = "cannot " + std::string(what) + " in " + options_.path + ": " + e.what() +
+            (kind.suggestion.empty() ? "" : " (" + kind.suggestion + ")");
   } catch (const std::exception& e) {
     error = "cannot " + std::string(what) + " in " + options_.path + ": " + e.what();
   }
-  report_failure(error);
+  report_failure(error, kind.suggestion, kind.disk_full);
   throw StorageError(error);
 }
 
-void StorageManager::report_failure(const std::string& message) {
+void StorageManager::note_write_ok() {
+  std::lock_guard lock(health_mutex_);
+  health_.ok = true;
+}
+
+WriteHealth StorageManager::write_health() const {
+  std::lock_guard lock(health_mutex_);
+  return health_;
+}
+
+void StorageManager::report_failure(const std::string& message, const std::string& suggestion,
+                                    bool disk_full) {
   write_failures_.fetch_add(1);
+  {
+    std::lock_guard lock(health_mutex_);
+    if (health_.ok) {  // a new episode: remember its first failure
+      health_.ok = false;
+      health_.error = message;
+      health_.suggestion = suggestion;
+      health_.disk_full = disk_full;
+      health_.episode_failures = 0;
+      ++health_.episodes;
+    }
+    ++health_.failures;
+    ++health_.episode_failures;
+  }
   // A handler that logs to this store and fails again must not recurse without end.
   thread_local bool in_handler = false;
   if (in_handler) return;

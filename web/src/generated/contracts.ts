@@ -95,7 +95,7 @@ export type ApiError = {
   field?: string;
 };
 
-/** GET /api/v1/healthz (no token needed): ok when the database answers and the drone is connected; degraded otherwise.
+/** GET /api/v1/healthz (no token needed): ok when the database answers and accepts writes and the drone is connected; degraded otherwise (db.error and db.suggestion then say why and what to do).
  * Schema: core/contracts/schemas/api_health.schema.json */
 export type Health = {
   status: "ok" | "degraded";
@@ -105,6 +105,14 @@ export type Health = {
     ok: boolean;
     path: string;
     write_failures: number;
+    /** the last database write succeeded */
+    writable: boolean;
+    /** while not writable: the writes failed for lack of space */
+    disk_full?: boolean;
+    /** while not writable: the first failed write of this episode */
+    error?: string;
+    /** while not writable: the fix */
+    suggestion?: string;
   };
   drone: WsStateData;
 };

@@ -10,6 +10,10 @@
 //          emergency_stop / reset_emergency / key(key, pressed) / submit(command)
 // Outputs: hub messages gesture, command, alert, telemetry, state (every 1 s and on change);
 //          the log callback gets one JSON object per command and safety event.
+//          Storage: when SQLite writes start failing (disk full, ...) the tick thread raises
+//          STORAGE_WRITE_FAILING (WARNING, cause and fix from storage::WriteHealth) and logs
+//          it, repeats the log every 10 s while it lasts, and raises STORAGE_RECOVERED (INFO)
+//          when writes succeed again. Flying is not affected.
 // Time   : the injected Clock; a tick thread calls ControlLoop::tick every tick_s.
 #pragma once
 
@@ -85,7 +89,9 @@ class DroneService {
  private:
   struct Active;
   void tick_loop();
+  void watch_storage();  // on the tick thread, outside every lock
   void stop_active_locked();
+  void end_session_quietly(std::int64_t session);  // never throws
 
   const contracts::Clock& clock_;
   storage::StorageManager& storage_;
@@ -107,6 +113,9 @@ class DroneService {
   std::vector<std::shared_ptr<runtime::EventListener>> extra_listeners_;
   std::string last_state_;
 
+  std::int64_t storage_episodes_seen_ = 0;  // tick thread only
+  bool storage_failing_ = false;
+  contracts::Duration storage_next_log_{};
   std::atomic<bool> running_{true};
   std::thread ticker_;
 };

@@ -54,6 +54,18 @@ struct AlertRecord {
   std::optional<contracts::UtcTime> acknowledged_at;
 };
 
+// Whether writes currently succeed, for health checks and alerts. A failing episode starts
+// with the first failed write and ends with the next write that succeeds.
+struct WriteHealth {
+  bool ok = true;               // the last write succeeded (or none was tried)
+  bool disk_full = false;       // the failing writes ran out of space (ENOSPC, EFBIG, SQLITE_FULL)
+  std::string error;            // the first failure of the current (or last) episode
+  std::string suggestion;       // the fix for that failure, for an operator
+  std::int64_t failures = 0;    // every failed write since open
+  std::int64_t episode_failures = 0;  // failed writes in the current (or last) episode
+  std::int64_t episodes = 0;    // how many failing episodes began since open
+};
+
 struct RetentionReport {
   std::int64_t telemetry_rows_deleted = 0;  // by age
   std::int64_t sessions_deleted = 0;        // by size, with all their rows

@@ -15,6 +15,8 @@
 //           returns a WriteResult that is not ok, is counted in write_failures() and goes to the
 //           error handler; the process keeps running. Other writes and reads throw StorageError
 //           (and a failed write among them is counted and reported the same way).
+//           A full disk (ENOSPC, a file-size limit's EFBIG, SQLITE_FULL) is named as such,
+//           with the fix "free disk space"; write_health() tells whether writes fail now.
 // Durability: WAL, synchronous=FULL, every write commits on its own: a kill -9 loses nothing
 //           that a call already returned as ok.
 // Threads:  every method may be called from any thread; one mutex serialises the connection.
@@ -115,6 +117,8 @@ class StorageManager {
   int schema_version() const;
   std::string path() const;
   std::int64_t write_failures() const { return write_failures_.load(); }
+  // Failing or not, since when, and why (with the fix). Cheap: poll it from a health loop.
+  WriteHealth write_health() const;
   void set_error_handler(std::function<void(const std::string&)> handler);
 
  private:
@@ -124,7 +128,10 @@ class StorageManager {
                             const std::function<std::int64_t()>& write);
   // For the other writes: the same, but the failure is then thrown as StorageError.
   void checked_write(std::string_view what, const std::function<void()>& write);
-  void report_failure(const std::string& message);  // call without holding mutex_
+  // call without holding mutex_; `suggestion` is the fix an operator should apply
+  void report_failure(const std::string& message, const std::string& suggestion = {},
+                      bool disk_full = false);
+  void note_write_ok();
   std::int64_t now_ms() const;
   std::int64_t live_size_locked() const;
 
@@ -134,6 +141,8 @@ class StorageManager {
   std::unique_ptr<detail::Connection> db_;
   int schema_version_ = 0;
   std::atomic<std::int64_t> write_failures_{0};
+  mutable std::mutex health_mutex_;  // guards health_
+  WriteHealth health_;
   std::mutex handler_mutex_;
   std::function<void(const std::string&)> error_handler_;
 };
