@@ -50,8 +50,13 @@ struct Tally {
   double landmark_error_max_pct = 0;
   std::array<double, contracts::kLandmarkCount> point_error_sum_pct{};
   std::array<std::array<std::int64_t, kClasses>, kClasses> confusion{};  // [true][predicted]
+  // Scored frames per shown pose (rendered fixtures: FIST, RELAXED, ...; "NO_HAND"), by the
+  // gesture read: which poses the recogniser confuses, not only which gestures.
+  std::map<std::string, std::map<std::string, std::int64_t>> by_pose;
 
   void add(const Tally& o) {
+    for (const auto& [pose, counts] : o.by_pose)
+      for (const auto& [g, n] : counts) by_pose[pose][g] += n;
     visible_frames += o.visible_frames;
     detected_frames += o.detected_frames;
     deliberate_scored += o.deliberate_scored;
@@ -135,6 +140,7 @@ json summary_json(const Tally& t) {
           {"visible_frames", t.visible_frames},
           {"detected_frames", t.detected_frames},
           {"per_class", per_class},
+          {"by_pose", t.by_pose},
           {"confusion", {{"labels", labels}, {"matrix", matrix}}}};
 }
 
@@ -248,6 +254,8 @@ Tally eval_fixture(const fs::path& dir, vision::HandFinder& finder,
         if (h.gesture != GestureType::kNone) predicted = h.gesture;
     }
     t.score(deliberate ? truth : GestureType::kNone, predicted, deliberate);
+    const std::string pose = l.value("hand_present", false) ? l.value("pose", "?") : "NO_HAND";
+    ++t.by_pose[pose][std::string(contracts::to_string(predicted))];
   }
   return t;
 }

@@ -1,13 +1,17 @@
 // `gbdcs fixture ...`: rendered and recorded hand-video fixtures (docs/FIXTURES.md).
+#include <array>
+#include <cmath>
 #include <filesystem>
 #include <iostream>
 #include <random>
 
 #include "command_registry.hpp"
 #include "commands.hpp"
+#include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "fixture_support.hpp"
+#include "gbdcs/gesture/hand_features.hpp"
 #include "gbdcs/vision/hand_tracker.hpp"
 #include "gbdcs/vision/vision_pipeline.hpp"
 #include "gbdcs/sim/fixture_renderer.hpp"
@@ -26,7 +30,27 @@ struct StillOptions {
   double distance_m = 0.6;
   std::uint32_t seed = 1;
   bool left = false;
+  double yaw_deg = 0;
+  double pitch_deg = 0;
+  double roll_deg = 0;
+  bool overlay = false;
+  bool json = false;
 };
+
+// |tip - wrist| / |PIP - wrist| per finger (index ... pinky), in pixels: about 1.4 for a
+// straight finger, 0.6 for one folded into a fist; what the recogniser's curl rules read.
+std::array<double, 4> curl_ratios(const std::array<contracts::Point3, contracts::kLandmarkCount>& p,
+                                  int w, int h) {
+  auto d = [&](std::size_t a, std::size_t b) {
+    return std::hypot((p[a].x - p[b].x) * w, (p[a].y - p[b].y) * h);
+  };
+  std::array<double, 4> out{};
+  for (std::size_t f = 0; f < 4; ++f) {
+    const std::size_t pip = contracts::kIndexMcp + 4 * f + 1;
+    out[f] = d(pip + 2, contracts::kWrist) / std::max(1e-9, d(pip, contracts::kWrist));
+  }
+  return out;
+}
 
 int run_still(const StillOptions& o) {
   const auto name = sim::pose_from_string(o.pose);
@@ -39,11 +63,79 @@ int run_still(const StillOptions& o) {
   hand.pose = sim::pose_for(*name, rng);
   hand.distance_m = o.distance_m;
   hand.handedness = o.left ? contracts::Handedness::kLeft : contracts::Handedness::kRight;
+  hand.yaw_deg = o.yaw_deg;
+  hand.pitch_deg = o.pitch_deg;
+  hand.roll_deg = o.roll_deg;
+  if (const auto dir = std::filesystem::path(o.output).parent_path(); !dir.empty())
+    std::filesystem::create_directories(dir);
   sim::HandScene scene(o.width, o.height);
   auto r = scene.render(hand);
   cv::Mat out(r.bgr.size(), CV_8UC3, cv::Scalar(170, 180, 190));
   r.bgr.copyTo(out, r.mask);
+  if (!o.overlay && !o.json) {
+    sim::save_png(o.output, out);
+    return 0;
+  }
+  // What our tracker and recogniser make of the still (tracking mode, settled over a few
+  // passes as on a held pose in a video), against the sites' ground truth.
+  static const contracts::SteadyClock clock;
+  auto finder = vision::make_tracker_finder(vision::TrackerOptions{}, clock);
+  cv::Mat rgb;
+  cv::cvtColor(out, rgb, cv::COLOR_BGR2RGB);
+  std::vector<contracts::Landmarks> hands;
+  for (int pass = 0; pass < 4; ++pass) hands = finder->find(rgb);
+  vision::HandClassifier classifier;
+  classifier.set_frame_size(o.width, o.height);
+  const auto results = classifier.classify(hands);
+  const auto& truth = r.landmarks.points;
+  contracts::Landmarks true_hand;
+  true_hand.points = truth;
+  true_hand.handedness = hand.handedness;
+  true_hand.score = 1;
+  const double aspect = static_cast<double>(o.width) / o.height;
+  auto features = [&](const contracts::Landmarks& h) {
+    const auto f = gesture::extract_features(h, aspect, 1.0);
+    const auto flat = gesture::extract_features(h, aspect, 0.0);  // image plane only
+    return nlohmann::json{{"finger_curl_deg", f.finger_curl_deg},
+                          {"finger_curl_deg_image_plane", flat.finger_curl_deg},
+                          {"thumb_bend_deg", f.thumb_bend_deg},
+                          {"thumb_lateral", f.thumb_lateral}};
+  };
+  // The recogniser on the ground truth says whether the pose itself reads as intended.
+  nlohmann::json doc = {{"pose", o.pose}, {"seed", o.seed},
+                        {"hand_size_px", r.landmarks.size_px},
+                        {"truth_gesture", contracts::to_string(classifier.recognize(true_hand).gesture)},
+                        {"truth_features", features(true_hand)},
+                        {"truth_curl_ratio", curl_ratios(truth, o.width, o.height)},
+                        {"found", !results.empty()}};
+  if (!results.empty()) {
+    const auto& tracked = results.front().landmarks.points;
+    std::array<double, contracts::kLandmarkCount> err{};
+    double sum = 0;
+    for (std::size_t i = 0; i < err.size(); ++i) {
+      err[i] = 100.0 *
+               std::hypot((tracked[i].x - truth[i].x) * o.width, (tracked[i].y - truth[i].y) * o.height) /
+               std::max(1.0, r.landmarks.size_px);
+      sum += err[i];
+    }
+    doc["gesture"] = contracts::to_string(results.front().gesture);
+    doc["tracked_curl_ratio"] = curl_ratios(tracked, o.width, o.height);
+    doc["tracked_features"] = features(results.front().landmarks);
+    doc["landmark_error_pct_mean"] = sum / static_cast<double>(err.size());
+    doc["landmark_error_pct_by_point"] = err;
+    if (o.overlay) {
+      auto px = [&](const contracts::Point3& p) {
+        return cv::Point(static_cast<int>(p.x * o.width), static_cast<int>(p.y * o.height));
+      };
+      for (std::size_t i = 0; i < err.size(); ++i) {
+        cv::circle(out, px(truth[i]), 3, {0, 220, 0}, cv::FILLED);
+        cv::circle(out, px(tracked[i]), 3, {0, 0, 255}, 1);
+        cv::line(out, px(tracked[i]), px(truth[i]), {0, 0, 255}, 1);
+      }
+    }
+  }
   sim::save_png(o.output, out);
+  if (o.json) std::cout << doc.dump() << "\n";
   return 0;
 }
 
@@ -129,6 +221,14 @@ void add_fixture_commands(CLI::App& app) {
   still->add_option("--distance", s.distance_m, "Metres from the camera");
   still->add_option("--seed", s.seed, "Seed of the pose's natural variation");
   still->add_flag("--left", s.left, "A left hand");
+  still->add_option("--yaw", s.yaw_deg, "Extra turn about the image vertical, degrees");
+  still->add_option("--pitch", s.pitch_deg, "Extra tilt about the image horizontal, degrees");
+  still->add_option("--roll", s.roll_deg, "Extra in-plane turn, degrees");
+  still->add_flag("--overlay", s.overlay,
+                  "Draw the true landmarks (green) and our tracker's (red) on the PNG");
+  still->add_flag("--json", s.json,
+                  "Print truth against tracking: the gesture read, curl ratios |tip-wrist| / "
+                  "|PIP-wrist| per finger, landmark error (% of the hand's size)");
   still->callback([] {
     try {
       g_exit_code = run_still(s);

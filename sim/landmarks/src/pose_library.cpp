@@ -41,7 +41,10 @@ struct FingerSpec {
 constexpr FingerSpec kExtended{3, 5, 5, 3.5};
 constexpr FingerSpec kFolded{85, 100, 60, 5};     // tight fist
 constexpr FingerSpec kHeld{80, 98, 55, 5};        // folded, held down by the thumb
-constexpr FingerSpec kRelaxedCurl{25, 35, 20, 4};
+// The resting hand (RELAXED): flexion grows from the index to the little finger, the
+// "cascade" of a hand at rest (MCP 30-45, PIP 40-55, DIP 15-22).
+constexpr std::array<FingerSpec, 4> kRestCascade{
+    {{30, 40, 15, 4}, {35, 45, 18, 4}, {40, 50, 20, 4}, {45, 55, 22, 4}}};
 constexpr FingerSpec kHalfCurl{45, 55, 30, 5};
 
 struct ThumbSpec {
@@ -256,7 +259,8 @@ HandPose pose_for(PoseName name, std::mt19937& rng) {
       face_camera(pose, 0.3, rng);
       break;
     case PoseName::kRelaxed:
-      pose = make(kThumbRelaxed, {&kRelaxedCurl, &kRelaxedCurl, &kRelaxedCurl, &kRelaxedCurl},
+      pose = make(kThumbRelaxed, {&kRestCascade[0], &kRestCascade[1], &kRestCascade[2],
+                                  &kRestCascade[3]},
                   8, rng);
       face_camera(pose, 0.3, rng);
       break;
