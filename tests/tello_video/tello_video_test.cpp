@@ -10,6 +10,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 #include <random>
+#include <thread>
 
 #include "gbdcs/adapters/tello_adapter.hpp"
 #include "gbdcs/adapters/tello_video_decoder.hpp"
@@ -305,6 +306,21 @@ TEST(TelloVideoLoopback, TheEmulatorStreamsTheTwinsCameraToTheSource) {
   const auto vs = source.stats();
   EXPECT_GE(vs.frames_decoded, 2u);
   EXPECT_EQ(vs.width, 320);
+
+  // A link loss silences the video as it silences the state stream.
+  emulator.set_link_lost(true);
+  const auto suppressed = streamer.stats().suppressed;
+  bool silenced = false;
+  for (int i = 0; i < 600 && !silenced; ++i) {  // up to 60 s on a loaded machine
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    silenced = streamer.stats().suppressed >= suppressed + 2;
+  }
+  EXPECT_TRUE(silenced) << "frames kept going out during the link loss";
+  const auto sent = streamer.stats().frames;
+  emulator.set_link_lost(false);
+  EXPECT_TRUE(source.next());  // may be the last picture from before the loss
+  EXPECT_TRUE(source.next());
+  EXPECT_GT(streamer.stats().frames, sent);
 }
 
 }  // namespace

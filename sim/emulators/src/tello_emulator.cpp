@@ -399,6 +399,11 @@ void TelloEmulator::set_link_lost(bool lost) {
   impl_->link_lost = lost;
 }
 
+bool TelloEmulator::link_lost() const {
+  std::lock_guard lock(impl_->mutex);
+  return impl_->link_lost;
+}
+
 void TelloEmulator::set_stream_handler(StreamHandler handler) {
   std::lock_guard lock(impl_->mutex);
   impl_->stream_handler = std::move(handler);

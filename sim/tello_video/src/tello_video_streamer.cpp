@@ -107,6 +107,7 @@ struct TelloVideoStreamer::Impl {
           mj_copyData(copy, model, sim.data());
           lost = sim.link_lost(sim.time_s());
         });
+        if (const auto* e = emulator.load()) lost = lost || e->link_lost();
         if (!renderer) {
           RendererOptions ro;
           ro.width = options.width;
@@ -173,6 +174,7 @@ struct TelloVideoStreamer::Impl {
   TelloVideoStreamOptions options;
   int fd = -1;
   std::thread worker;
+  std::atomic<const TelloEmulator*> emulator{nullptr};  // its set_link_lost() silences us
 
   mutable std::mutex mutex;
   std::condition_variable cv;
@@ -188,6 +190,7 @@ TelloVideoStreamer::TelloVideoStreamer(TwinHost& host, TelloVideoStreamOptions o
 TelloVideoStreamer::~TelloVideoStreamer() = default;
 
 void TelloVideoStreamer::attach(TelloEmulator& emulator) {
+  impl_->emulator = &emulator;
   emulator.set_stream_handler([this](bool on, const std::string& client_address) {
     if (!on) return stop();
     try {

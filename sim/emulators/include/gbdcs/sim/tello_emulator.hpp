@@ -82,6 +82,7 @@ class TelloEmulator {
   std::uint16_t port() const;
   void set_state_port(int port);
   void set_link_lost(bool lost);
+  bool link_lost() const;  // set_link_lost()'s flag (the fault schedule is the twin's)
   TelloEmulatorStats stats() const;
 
   // streamon / streamoff from the client (in SDK mode): handler(true, the client's IP

@@ -12,8 +12,8 @@
 // Time     frames are paced on the wall clock (a video stream is real time); each frame shows
 //          the twin's state at the moment it is rendered (a copy taken under the host's lock,
 //          so the stepping thread never waits for the renderer).
-// Faults   during the twin's link loss (set_link_lost or the fault schedule) no datagram is
-//          sent, as over an out-of-range Wi-Fi.
+// Faults   during a link loss (the attached emulator's set_link_lost, or a link_loss in the
+//          twin's fault schedule) no datagram is sent, as over an out-of-range Wi-Fi.
 // Threads  one worker thread owns the Renderer (OSMesa) and the encoder; attach() hooks the
 //          emulator's streamon/streamoff; stop the streamer (destructor) before the emulator
 //          and the host it renders.
