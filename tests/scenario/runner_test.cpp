@@ -1,5 +1,6 @@
-// The runner end to end on the twin and the dummy: a flight that must pass, the same flight
-// judged by a wrong expectation that must fail, and the artifacts of a run.
+// The runner end to end on the twin, the dummy and the emulator drones: a flight that must
+// pass, the same flight judged by a wrong expectation that must fail, two emulator runs that
+// must agree, and the artifacts of a run.
 #include <gtest/gtest.h>
 
 #include <unistd.h>
@@ -81,6 +82,70 @@ TEST(ScenarioRunner, DummyFlightAndItsLimits) {
   EXPECT_FALSE(bad.passed);
   EXPECT_FALSE(bad.error.empty());
   EXPECT_THROW((void)run_scenario(Scenario::from_json(doc)), std::invalid_argument);
+}
+
+// The emulator drones: the real adapter over loopback sockets, lockstep. Two runs of the same
+// flight must give the same record (commands with their simulated times and outcomes, the
+// telemetry frames) however the threads were scheduled.
+TEST(ScenarioRunner, EmulatorFlightsAreDeterministic) {
+  for (const char* drone : {"tello-emulator", "airsim-emulator"}) {
+    RunOptions o;
+    o.keep_record = true;
+    const auto first = run_scenario(Scenario::from_json(flight(drone)), o);
+    const auto second = run_scenario(Scenario::from_json(flight(drone)), o);
+    for (const auto* r : {&first, &second}) {
+      ASSERT_TRUE(r->error.empty()) << drone << ": " << r->error;
+      for (const auto& c : r->criteria) {
+        EXPECT_NE(c.verdict, Verdict::kFailure) << drone << " " << c.name << ": " << c.actual;
+      }
+    }
+    ASSERT_EQ(first.record.commands.size(), second.record.commands.size()) << drone;
+    for (std::size_t i = 0; i < first.record.commands.size(); ++i) {
+      const auto& a = first.record.commands[i];
+      const auto& b = second.record.commands[i];
+      EXPECT_EQ(a.t_s, b.t_s) << drone << " command " << i;
+      EXPECT_EQ(a.command.type, b.command.type) << drone << " command " << i;
+      EXPECT_EQ(a.outcome, b.outcome) << drone << " command " << i;
+    }
+    ASSERT_EQ(first.record.telemetry.size(), second.record.telemetry.size()) << drone;
+    ASSERT_FALSE(first.record.telemetry.empty());
+    for (std::size_t i = 0; i < first.record.telemetry.size(); ++i) {
+      const auto& a = first.record.telemetry[i];
+      const auto& b = second.record.telemetry[i];
+      EXPECT_EQ(a.t_s, b.t_s) << drone << " frame " << i;
+      EXPECT_EQ(a.frame.altitude_m, b.frame.altitude_m) << drone << " frame " << i;
+      EXPECT_EQ(a.frame.x_m, b.frame.x_m) << drone << " frame " << i;
+      EXPECT_EQ(a.frame.flight_state, b.frame.flight_state) << drone << " frame " << i;
+    }
+  }
+}
+
+TEST(ScenarioRunner, EmulatorDroneOptionsAndLimitsAreNamed) {
+  auto doc = flight("tello-emulator");
+  doc["drone"] = {{"type", "tello-emulator"},
+                  {"options", {{"adapter", {{"address", "192.168.10.1"}}}}}};
+  try {
+    (void)run_scenario(Scenario::from_json(doc));
+    FAIL() << "an address of its own was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("'address' is the runner's"), std::string::npos)
+        << e.what();
+  }
+  doc["drone"] = {{"type", "airsim-emulator"}, {"options", {{"adapters", nlohmann::json::object()}}}};
+  try {
+    (void)run_scenario(Scenario::from_json(doc));
+    FAIL() << "an unknown option key was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("unknown key 'adapters'"), std::string::npos) << e.what();
+  }
+  doc = flight("xfly-emulator");
+  doc["events"] = {{{"at_s", 1}, {"type", "telemetry_delay"}, {"duration_s", 1}, {"delay_ms", 200}}};
+  try {
+    (void)run_scenario(Scenario::from_json(doc));
+    FAIL() << "a telemetry delay was accepted by an emulator drone";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("fly the twin"), std::string::npos) << e.what();
+  }
 }
 
 TEST(ScenarioRunner, WritesArtifacts) {

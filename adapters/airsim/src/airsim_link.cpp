@@ -210,8 +210,7 @@ std::shared_ptr<AirSimLink::Call> AirSimLink::call_locked(
   c->is_state = is_state;
   const double life_s = deferred ? std::max(options.takeoff_timeout_s, options.land_timeout_s) + 5
                                  : options.rpc_timeout_ms / 1000.0;
-  c->expires = WallClock::now() + std::chrono::duration_cast<WallClock::duration>(
-                                      std::chrono::duration<double>(life_s));
+  c->expires = clock.now() + contracts::from_seconds(life_s);
   const auto id = next_id_++;
   const auto bytes = airsim::encode_request(id, method, [&](Packer& p) { params(p); });
   calls[id] = c;
@@ -235,8 +234,7 @@ std::shared_ptr<AirSimLink::Call> AirSimLink::wait_locked(
   if (!c->done) {
     if (deferred) {
       c->deferred = true;
-      c->expires = WallClock::now() + std::chrono::seconds(
-                                          static_cast<long>(options.land_timeout_s + 5));
+      c->expires = clock.now() + contracts::from_seconds(options.land_timeout_s + 5);
     }
   }
   return c;
@@ -270,10 +268,12 @@ Result AirSimLink::check(const std::shared_ptr<Call>& c, const std::string& what
   return Result::kOk;
 }
 
+// Calls nobody waits for any more expire on the injected clock (simulated time in a lockstep
+// run); the blocking waits themselves are real time (a socket's).
 void AirSimLink::expire_calls_locked() {
-  const auto wall = WallClock::now();
+  const auto now = clock.now();
   for (auto it = calls.begin(); it != calls.end();) {
-    if (it->second->expires < wall) {
+    if (it->second->expires < now) {
       it->second->done = true;
       it = calls.erase(it);
     } else {

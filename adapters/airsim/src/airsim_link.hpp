@@ -47,7 +47,7 @@ class AirSimLink {
     msgpack::object_handle result;
     bool deferred = false;  // nobody waits: a late error or `false` is logged
     bool is_state = false;
-    WallClock::time_point expires;
+    contracts::Duration expires{0};  // on the injected clock
   };
 
   // Throws std::invalid_argument when 'address' is not an IP address.

@@ -10,7 +10,7 @@ namespace asio = boost::asio;
 namespace {
 
 constexpr auto kTickPeriod = std::chrono::milliseconds(10);
-constexpr double kDeferredReplyS = 20;  // take-off/land replies come within this (wall)
+constexpr double kDeferredReplyS = 20;  // take-off/land replies come within this (clock)
 
 }  // namespace
 
@@ -139,7 +139,7 @@ std::shared_ptr<TelloLink::Pending> TelloLink::send_locked(const std::string& te
   if (expect_reply) {
     p = std::make_shared<Pending>();
     p->command = text;
-    p->expires = WallClock::now() + std::chrono::milliseconds(options.reply_timeout_ms);
+    p->expires = clock.now() + contracts::from_seconds(options.reply_timeout_ms / 1000.0);
     pending.push_back(p);
   }
   boost::system::error_code ec;
@@ -173,8 +173,7 @@ std::optional<std::string> TelloLink::request_locked(std::unique_lock<std::mutex
   if (p->done) return std::nullopt;  // expired or abandoned (an emergency cleared it)
   if (deferred) {
     p->deferred = true;
-    p->expires = WallClock::now() + std::chrono::duration_cast<WallClock::duration>(
-                                        std::chrono::duration<double>(kDeferredReplyS));
+    p->expires = clock.now() + contracts::from_seconds(kDeferredReplyS);
   } else {
     abandon_locked(p);
   }
@@ -192,9 +191,11 @@ void TelloLink::abandon_all_locked() {
   reply_cv.notify_all();
 }
 
+// Replies nobody waits for (keep-alive, take-off/land) expire on the injected clock, so a
+// lockstep run gives a lost one up after the same simulated time as a real flight would.
 void TelloLink::expire_pending_locked() {
-  const auto wall = WallClock::now();
-  while (!pending.empty() && pending.front()->expires < wall) {
+  const auto now = clock.now();
+  while (!pending.empty() && pending.front()->expires < now) {
     pending.front()->done = true;  // never answered: lost
     pending.pop_front();
   }

@@ -48,7 +48,7 @@ class TelloLink {
     bool answered = false;  // `reply` holds the drone's answer
     bool deferred = false;  // the caller stopped waiting (take-off/land): outcome logged only
     std::string reply;
-    WallClock::time_point expires;
+    contracts::Duration expires{0};  // on the injected clock
   };
 
   // Binds both local sockets; throws std::invalid_argument (addresses) or std::runtime_error

@@ -2,6 +2,8 @@
 // artifacts written for a run.
 #pragma once
 
+#include <cstdint>
+#include <functional>
 #include <memory>
 #include <opencv2/core/mat.hpp>
 #include <optional>
@@ -11,6 +13,7 @@
 #include "gbdcs/contracts/clock.hpp"
 #include "gbdcs/control/drone_adapter.hpp"
 #include "gbdcs/sim/scenario.hpp"
+#include "gbdcs/sim/faults.hpp"
 #include "gbdcs/sim/scenario_criteria.hpp"
 #include "gbdcs/sim/twin_model.hpp"
 
@@ -48,7 +51,26 @@ class ScenarioDrone {
   // drone has no physics (the runner places the model from telemetry instead).
   virtual std::vector<double> pose_qpos() const = 0;
   virtual std::string describe() const = 0;
+
+  // Drones behind sockets (the emulators) keep lockstep with these; in-process ones need not.
+  // advance(): after the core clock moved, step the drone's world to it and let its output
+  // arrive; settle(): after the loop's tick, wait until nothing is in flight. False when the
+  // link did not settle in time (settle_error() says why): the run stops with that error.
+  virtual bool advance() { return true; }
+  virtual bool settle() { return true; }
+  virtual std::string settle_error() const { return {}; }
+  // How many telemetry frames the core has taken in full (every inline observer ran): a frame
+  // the adapter made but the core has not taken yet is still in flight for settle().
+  virtual void count_frames_taken(std::function<std::uint64_t()> taken) { (void)taken; }
 };
+
+// The scenario's physical and radio faults as the twin's schedule, after `base`.
+FaultSchedule faults_of(const Scenario& scenario, std::vector<Fault> base);
+
+// tello-emulator, airsim-emulator, xfly-emulator (emulator_drone.cpp).
+std::unique_ptr<ScenarioDrone> make_emulator_drone(const Scenario& scenario,
+                                                   const contracts::Clock& clock,
+                                                   std::shared_ptr<const TwinModel> model);
 
 // Throws std::invalid_argument when the drone cannot take one of the scenario's events.
 std::unique_ptr<ScenarioDrone> make_scenario_drone(const Scenario& scenario,

@@ -17,8 +17,6 @@ std::shared_ptr<const TwinModel> shared_twin_model() {
   return model;
 }
 
-namespace {
-
 // ---- drones -----------------------------------------------------------------------------
 
 FaultSchedule faults_of(const Scenario& s, std::vector<Fault> base) {
@@ -53,6 +51,8 @@ FaultSchedule faults_of(const Scenario& s, std::vector<Fault> base) {
   }
   return FaultSchedule(std::move(base));
 }
+
+namespace {
 
 class TwinDrone final : public ScenarioDrone {
  public:
@@ -160,11 +160,8 @@ std::unique_ptr<ScenarioDrone> make_scenario_drone(const Scenario& s, const cont
   switch (s.drone.kind) {
     case DroneKind::kTwin: return std::make_unique<TwinDrone>(s, clock, std::move(model));
     case DroneKind::kDummy: return std::make_unique<DummyDrone>(s, clock);
-    default: break;
+    default: return make_emulator_drone(s, clock, std::move(model));
   }
-  throw std::invalid_argument("drone '" + std::string(to_string(s.drone.kind)) +
-                              "' is not available in this build yet (its emulator has not "
-                              "landed); use twin or dummy");
 }
 
 std::unique_ptr<ScenarioCamera> open_scenario_camera(const CameraSpec& spec,

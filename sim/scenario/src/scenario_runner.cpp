@@ -58,6 +58,11 @@ class Recorder final : public runtime::EventListener {
   void on_frame_telemetry(const contracts::TelemetryFrame& f) {
     std::lock_guard lock(mutex_);
     record_.telemetry.push_back({now_s(), f});
+    ++frames_taken_;  // the last inline observer: the failsafe has seen this frame too
+  }
+  std::uint64_t frames_taken() const {
+    std::lock_guard lock(mutex_);
+    return frames_taken_;
   }
   void frame_started(WallClock::time_point t) {
     std::lock_guard lock(mutex_);
@@ -91,6 +96,7 @@ class Recorder final : public runtime::EventListener {
   std::optional<WallClock::time_point> gesture_frame_start_;
   std::string last_command_;
   std::string last_alert_;
+  std::uint64_t frames_taken_ = 0;
 };
 
 nlohmann::json merged(nlohmann::json base, const nlohmann::json& over) {
@@ -136,6 +142,7 @@ ScenarioResult run_scenario(const Scenario& s, const RunOptions& options) {
                                  recorder->on_frame_telemetry(f);
                                }),
       telemetry::Delivery::kInline);
+  drone->count_frames_taken([recorder] { return recorder->frames_taken(); });
 
   std::vector<LoggedEvent> logged;
   std::vector<VideoSnapshot> video;
@@ -144,11 +151,21 @@ ScenarioResult run_scenario(const Scenario& s, const RunOptions& options) {
   const double video_period_s = 1.0 / options.video_fps;
   double next_video_s = 0;
 
+  double t_s = 0;
   if (auto r = loop.start(); r != control::Result::kOk) {
     result.error = "cannot connect to the " + drone->describe() + " drone: " +
                    std::string(control::to_string(r)) + " " + drone->adapter().last_error();
     return result;
   }
+  // A drone behind sockets: lockstep means nothing in flight whenever the clock moves.
+  std::string link_error;
+  auto in_step = [&](bool ok) {
+    if (!ok && link_error.empty()) {
+      link_error = drone->settle_error() + " at " + std::to_string(t_s).substr(0, 6) + " s";
+    }
+    return ok;
+  };
+  in_step(drone->settle());
 
   std::vector<Pending> pending;
   for (std::size_t i = 0; i < s.events.size(); ++i) pending.push_back({s.events[i].at_s, i, true});
@@ -166,10 +183,10 @@ ScenarioResult run_scenario(const Scenario& s, const RunOptions& options) {
   const control::KeyboardInput keyboard;
   const double fps = camera->fps();
   const auto steps = static_cast<std::int64_t>(std::floor(s.timeout_s * fps + 1e-9));
-  double t_s = 0;
-  for (std::int64_t i = 0; i <= steps; ++i) {
+  for (std::int64_t i = 0; i <= steps && link_error.empty(); ++i) {
     t_s = static_cast<double>(i) / fps;
     clock.set(contracts::from_seconds(t_s));
+    if (!in_step(drone->advance())) break;
 
     while (next_pending < pending.size() && pending[next_pending].at_s <= t_s + 1e-9) {
       const auto p = pending[next_pending++];
@@ -216,6 +233,7 @@ ScenarioResult run_scenario(const Scenario& s, const RunOptions& options) {
       }
     }
     loop.tick();
+    if (!in_step(drone->settle())) break;
 
     if (want_video && t_s + 1e-9 >= next_video_s) {
       next_video_s += video_period_s;
@@ -247,6 +265,10 @@ ScenarioResult run_scenario(const Scenario& s, const RunOptions& options) {
   result.criteria = evaluate_all(s, record);
   result.passed = std::none_of(result.criteria.begin(), result.criteria.end(),
                                [](const auto& c) { return c.verdict == Verdict::kFailure; });
+  if (!link_error.empty()) {  // the run stopped early: its criteria say little
+    result.error = link_error;
+    result.passed = false;
+  }
 
   if (want_video && (options.artifacts_always || !result.passed)) {
     const auto dir = (std::filesystem::path(options.artifacts_dir) / s.name).string();

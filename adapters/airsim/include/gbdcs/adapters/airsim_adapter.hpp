@@ -23,7 +23,8 @@
 //                (reconnect_min_s doubling to reconnect_max_s), then API control and arming
 //                are asked again.
 // Time / threads as TelloAdapter: the injected Clock drives the timers (an I/O thread ticks
-//                every 10 ms, and poll()); RPC waits are real time; nothing throws across the
+//                every 10 ms, and poll()); a blocked RPC call waits real time, calls nobody
+//                waits for expire on the Clock; nothing throws across the
 //                interface; malformed frames from the server are dropped and counted.
 #pragma once
 

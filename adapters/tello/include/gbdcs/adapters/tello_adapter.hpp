@@ -30,7 +30,8 @@
 //   commands are kNotConnected); datagrams again -> OK, and "command" is sent again.
 // Time   : the rc stream, keep-alive, timed moves and link watchdog read the injected Clock
 //   (ticked by an I/O thread every 10 ms and by poll()), so lockstep tests run on a
-//   ManualClock; waits for replies are real time (a socket's).
+//   ManualClock; a call blocked on its reply waits real time (a socket's), while replies
+//   nobody waits for (keep-alive, take-off/land answered late) expire on the Clock.
 // Errors : nothing throws across the interface; the constructor throws std::runtime_error
 //   when a local port cannot be bound (with the fix) and std::invalid_argument for options.
 // Threads: any thread may call; the sink is called from the I/O thread or poll().

@@ -4,9 +4,12 @@
 // Wiring (the same classes as `gbdcs fly` and `gbdcs serve`): camera frames -> ControlLoop
 // (GestureEngine with the RuleBasedRecognizer, CommandTranslator with the scenario's profile,
 // CommandArbiter, FailsafeMonitor with the scenario's failsafe options) -> the drone's adapter
-// (sim::TwinAdapter, adapters::DummyDroneAdapter, ...). A ManualClock is the only clock: each
-// step sets it to frame i / fps, applies the events due, hands the frame to the loop, and
-// ticks the loop (which steps the twin to that time and runs the failsafe timers).
+// (sim::TwinAdapter, adapters::DummyDroneAdapter, or the registry's real Tello / AirSim /
+// XFly adapter talking over loopback sockets to the twin's in-process emulator). A
+// ManualClock is the only clock: each step sets it to frame i / fps, applies the events due,
+// hands the frame to the loop, and ticks the loop (which steps the twin to that time and runs
+// the failsafe timers). An emulator drone's twin is stepped by the runner too, and each step
+// waits (real time, bounded) until nothing is in flight on its sockets (docs/SCENARIOS.md).
 //
 // Events : physical and radio faults (link_loss, telemetry_delay, battery_jump, wind_gust,
 //          motor_fault) go into the twin's FaultSchedule on simulated time (the dummy takes
