@@ -102,7 +102,10 @@ void rest_request(Bytes input) {
           kName,
           "a request was answered 500 (an unexpected failure, not a clear 4xx): " +
               out.substr(0, 600));
-  require(out.find(kOutsideMarker) == std::string::npos, kName,
+  // Only a successful answer can carry a file: an error may echo the requested path, and the
+  // fuzzer learns the marker and puts it there (a false alarm found in the 10-minute run).
+  const bool success = out.rfind("HTTP/1.1 2", 0) == 0 || out.rfind("HTTP/1.0 2", 0) == 0;
+  require(!success || out.find(kOutsideMarker) == std::string::npos, kName,
           "a response carries a file from outside the dashboard folder: " + out.substr(0, 600));
 }
 

@@ -154,6 +154,10 @@ nlohmann::json parse_json(std::string_view text) {
   } catch (const nlohmann::json::parse_error& e) {
     throw ContractError("", "malformed JSON at byte " + std::to_string(e.byte) + ": " +
                                 e.what() + " (send one well-formed JSON document)");
+  } catch (const nlohmann::json::exception& e) {
+    // A number too large for a double (1e999) is out_of_range, not a parse_error (fuzzing).
+    throw ContractError("", std::string("malformed JSON: ") + e.what() +
+                                " (send one well-formed JSON document; numbers must fit a double)");
   }
 }
 

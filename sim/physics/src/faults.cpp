@@ -165,6 +165,8 @@ FaultSchedule FaultSchedule::from_json_text(std::string_view text) {
   } catch (const nlohmann::json::parse_error& e) {
     throw std::invalid_argument("FaultSchedule: malformed JSON at byte " + std::to_string(e.byte) +
                                 ": " + e.what());
+  } catch (const nlohmann::json::exception& e) {  // out_of_range: a number too large (1e999)
+    throw std::invalid_argument(std::string("FaultSchedule: malformed JSON: ") + e.what());
   }
   return from_json(doc);
 }
