@@ -55,6 +55,16 @@ void Metrics::count_request(int status) {
   ++requests_by_status_[status];
 }
 
+std::uint64_t Metrics::requests_with_status(int lo, int hi) const {
+  std::lock_guard lock(mutex_);
+  std::uint64_t n = 0;
+  for (auto it = requests_by_status_.lower_bound(lo); it != requests_by_status_.end() && it->first <= hi;
+       ++it) {
+    n += it->second;
+  }
+  return n;
+}
+
 void Metrics::gauge(const std::string& name, const std::string& help,
                     std::function<double()> read) {
   std::lock_guard lock(mutex_);

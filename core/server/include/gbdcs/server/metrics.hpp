@@ -34,6 +34,8 @@ class Metrics {
  public:
   Metrics();
   void count_request(int status);
+  // Requests answered so far with a status in [lo, hi] (a 5xx count: 500, 599).
+  std::uint64_t requests_with_status(int lo, int hi) const;
   Histogram request_ms;
   Histogram vision_latency_ms;
   Histogram ws_delivery_ms;
