@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
@@ -120,6 +121,83 @@ TEST(VideoSource, ReadsEveryFrameThenEnds) {
     EXPECT_EQ(f->source, file.string());
   }
   EXPECT_EQ(source->next(), std::nullopt);
+}
+
+// The file as a camera: paced by the injected clock (the test moves it, so next() never
+// sleeps), frames whose time has passed are skipped, the end loops to the start.
+TEST(LiveVideoSource, PlaysAtTheFileRateSkipsWhenBehindAndLoops) {
+  TempDir dir;
+  const auto file = dir.path() / "clip.avi";
+  {
+    cv::VideoWriter writer(file.string(), cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 10,
+                           cv::Size(64, 48));
+    if (!writer.isOpened()) GTEST_SKIP() << "this OpenCV cannot write MJPG .avi";
+    for (int i = 0; i < 5; ++i) {
+      const auto v = static_cast<unsigned char>(20 + 40 * i);
+      writer.write(solid(64, 48, {v, v, v}));
+    }
+  }
+  contracts::ManualClock clock;
+  const std::string spec = "video:" + file.string() + "?live=1";
+  auto source = open_source(spec, clock);
+  EXPECT_TRUE(source->live());
+  EXPECT_EQ(source->describe(), spec);
+  // Which of the five frames was delivered: by its grey level.
+  auto index_of = [](const Frame& f) {
+    return static_cast<int>(std::lround((cv::mean(f.rgb)[0] - 20) / 40));
+  };
+  std::vector<int> seen;
+  std::vector<std::int64_t> ids;
+  auto take = [&] {
+    auto f = source->next();
+    ASSERT_TRUE(f);
+    EXPECT_EQ(f->order, PixelOrder::kBgr);
+    seen.push_back(index_of(*f));
+    ids.push_back(f->frame_id);
+  };
+  take();                  // t = 0: frame 0
+  clock.advance(100ms);    // frame 1 due
+  take();
+  clock.advance(305ms);    // 0.405 s: frames 2 and 3 passed while "busy", 4 is due
+  take();
+  clock.advance(100ms);    // 0.505 s: frame 5 = the first again (a 5-frame loop)
+  take();
+  clock.advance(100ms);
+  take();
+  EXPECT_EQ(seen, (std::vector<int>{0, 1, 4, 0, 1}));
+  EXPECT_EQ(ids, (std::vector<std::int64_t>{0, 1, 2, 3, 4}));  // delivered frames, no gaps
+
+  // fps= overrides the file's rate: 20 fps, so 50 ms is one frame.
+  auto fast = open_source("video:" + file.string() + "?live=1&fps=20", clock);
+  ASSERT_TRUE(fast->next());
+  clock.advance(50ms);
+  auto second = fast->next();
+  ASSERT_TRUE(second);
+  EXPECT_EQ(index_of(*second), 1);
+}
+
+TEST(LiveVideoSource, BadOptionsSayWhatIsAllowed) {
+  TempDir dir;
+  const auto file = dir.path() / "clip.avi";
+  {
+    cv::VideoWriter writer(file.string(), cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 10,
+                           cv::Size(64, 48));
+    if (!writer.isOpened()) GTEST_SKIP() << "this OpenCV cannot write MJPG .avi";
+    writer.write(solid(64, 48, {40, 80, 120}));
+  }
+  contracts::ManualClock clock;
+  const auto base = "video:" + file.string();
+  const auto unknown = error_of([&] { open_source(base + "?loop=1", clock); });
+  EXPECT_NE(unknown.find("unknown option \"loop=1\""), std::string::npos) << unknown;
+  EXPECT_NE(unknown.find("live=1"), std::string::npos) << unknown;
+  const auto fps = error_of([&] { open_source(base + "?live=1&fps=fast", clock); });
+  EXPECT_NE(fps.find("fps=30"), std::string::npos) << fps;
+  const auto no_live = error_of([&] { open_source(base + "?fps=30", clock); });
+  EXPECT_NE(no_live.find("needs live=1"), std::string::npos) << no_live;
+  const auto missing = error_of([&] { open_source("video:/nonexistent/x.mp4?live=1", clock); });
+  EXPECT_NE(missing.find("no such file"), std::string::npos) << missing;
+  // Without live=1 it is the plain offline file.
+  EXPECT_FALSE(open_source(base + "?live=0", clock)->live());
 }
 
 TEST(VideoSource, MissingOrUndecodableFileIsAClearError) {

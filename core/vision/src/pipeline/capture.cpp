@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cctype>
 #include <charconv>
+#include <cmath>
+#include <thread>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 #include <opencv2/videoio/registry.hpp>
@@ -113,6 +115,98 @@ class VideoSource final : public CaptureSource {
   std::int64_t next_id_ = 0;
 };
 
+// A video file as a camera: frame k (counting over every loop) is due at start + k/fps; a
+// frame whose time has passed is grabbed (decoded, not converted) and skipped; the end of the
+// file reopens it. The frame count is the file's own figure, corrected by the first short read.
+class LiveVideoSource final : public CaptureSource {
+ public:
+  LiveVideoSource(const fs::path& path, const contracts::Clock& clock, double fps,
+                  std::string name)
+      : clock_(clock),
+        name_(name.empty() ? "video:" + path.string() + "?live=1" : std::move(name)),
+        path_(path.string()) {
+    std::error_code ec;
+    if (!fs::is_regular_file(path, ec)) {
+      throw CaptureError(name_ + ": no such file (check the path; it is relative to " +
+                         fs::current_path(ec).string() + ")");
+    }
+    open();
+    fps_ = fps > 0 ? fps : capture_.get(cv::CAP_PROP_FPS);
+    if (!(fps_ > 0 && fps_ <= 1000)) {
+      throw CaptureError(name_ + ": the file does not say its frame rate; give it as " +
+                         "video:PATH?live=1&fps=30");
+    }
+    const double count = capture_.get(cv::CAP_PROP_FRAME_COUNT);
+    count_ = count >= 1 ? static_cast<std::int64_t>(count) : 0;
+  }
+  std::optional<Frame> next() override {
+    if (!started_) {
+      started_ = true;
+      start_ = clock_.now();
+    }
+    std::int64_t want = last_ + 1;
+    const auto due = start_ + contracts::from_seconds(static_cast<double>(want) / fps_);
+    const auto now = clock_.now();
+    if (due > now) {
+      std::this_thread::sleep_for(due - now);
+    } else {
+      const auto behind =
+          static_cast<std::int64_t>(std::floor(contracts::to_seconds(now - start_) * fps_));
+      want = std::max(want, behind);
+    }
+    last_ = want;
+    cv::Mat pixels = read_at(want);
+    check_pixels(pixels, name_);
+    return stamp(std::move(pixels), next_id_++, clock_, name_, PixelOrder::kBgr);
+  }
+  bool live() const override { return true; }
+  std::string describe() const override { return name_; }
+
+ private:
+  void open() {
+    capture_.release();
+    if (!capture_.open(path_, video_file_api()) || !capture_.isOpened()) {
+      throw CaptureError(name_ + ": OpenCV cannot decode this file (is it a video? convert it " +
+                         "with `ffmpeg -i " + path_ + " out.mp4`)");
+    }
+    position_ = 0;
+  }
+  // The frame at loop position `index % count`, reading forward from where the file is.
+  cv::Mat read_at(std::int64_t index) {
+    for (int attempt = 0; attempt < 3; ++attempt) {
+      const std::int64_t local = count_ > 0 ? index % count_ : index;
+      if (local < position_) open();
+      bool ok = true;
+      while (ok && position_ < local) {
+        ok = capture_.grab();
+        if (ok) ++position_;
+      }
+      cv::Mat pixels;
+      if (ok && capture_.read(pixels) && !pixels.empty()) {
+        ++position_;
+        return pixels;
+      }
+      // The file is shorter than it said (or than `index`): that is its length.
+      if (position_ == 0) break;
+      count_ = position_;
+      open();
+    }
+    throw CaptureError(name_ + ": no frame could be read (an empty or damaged video?)");
+  }
+
+  const contracts::Clock& clock_;
+  std::string name_;
+  std::string path_;
+  cv::VideoCapture capture_;
+  double fps_ = 0;
+  std::int64_t count_ = 0;     // frames in the file; 0 = not known yet
+  std::int64_t position_ = 0;  // index of the next frame the decoder gives
+  bool started_ = false;
+  contracts::Duration start_{};
+  std::int64_t last_ = -1;  // the frame index (over all loops) delivered last
+  std::int64_t next_id_ = 0;
+};
+
 class ImageFolderSource final : public CaptureSource {
  public:
   ImageFolderSource(const fs::path& dir, const contracts::Clock& clock)
@@ -137,6 +231,45 @@ class ImageFolderSource final : public CaptureSource {
   std::size_t next_index_ = 0;
   std::int64_t next_id_ = 0;
 };
+
+// video:PATH or video:PATH?live=1[&fps=N]. A path that exists as given wins over options.
+std::unique_ptr<CaptureSource> open_video_spec(const std::string& rest, const std::string& spec,
+                                               const contracts::Clock& clock) {
+  std::error_code ec;
+  const auto q = rest.rfind('?');
+  if (q == std::string::npos || fs::exists(rest, ec)) return open_video(rest, clock);
+  bool live = false;
+  double fps = 0;
+  std::string query = rest.substr(q + 1);
+  for (std::size_t start = 0; start <= query.size();) {
+    const auto amp = std::min(query.find('&', start), query.size());
+    const std::string option = query.substr(start, amp - start);
+    start = amp + 1;
+    if (option == "live=1" || option == "live=true") {
+      live = true;
+    } else if (option.rfind("fps=", 0) == 0) {
+      try {
+        std::size_t used = 0;
+        fps = std::stod(option.substr(4), &used);
+        if (used != option.size() - 4) fps = -1;
+      } catch (const std::exception&) {
+        fps = -1;
+      }
+      if (!(fps > 0 && fps <= 1000)) {
+        throw CaptureError("source '" + spec + "': fps must be a number from 0 to 1000, as in fps=30");
+      }
+    } else if (option != "live=0" && option != "live=false") {
+      throw CaptureError("source '" + spec + "': unknown option \"" + option +
+                         "\"; the options are live=1 and fps=N (with live=1)");
+    }
+  }
+  const fs::path path = rest.substr(0, q);
+  if (!live) {
+    if (fps > 0) throw CaptureError("source '" + spec + "': fps=N needs live=1");
+    return open_video(path, clock);
+  }
+  return open_live_video(path, clock, fps, spec);
+}
 
 }  // namespace
 
@@ -179,6 +312,11 @@ std::unique_ptr<CaptureSource> open_video(const fs::path& path, const contracts:
   return std::make_unique<VideoSource>(path, clock);
 }
 
+std::unique_ptr<CaptureSource> open_live_video(const fs::path& path, const contracts::Clock& clock,
+                                               double fps, std::string name) {
+  return std::make_unique<LiveVideoSource>(path, clock, fps, std::move(name));
+}
+
 std::unique_ptr<CaptureSource> open_images(const fs::path& dir, const contracts::Clock& clock) {
   return std::make_unique<ImageFolderSource>(dir, clock);
 }
@@ -206,7 +344,7 @@ std::unique_ptr<CaptureSource> open_source(std::string_view spec, const contract
     }
     return open_camera(index, clock);
   }
-  if (scheme == "video") return open_video(fs::path(std::string(rest)), clock);
+  if (scheme == "video") return open_video_spec(std::string(rest), std::string(spec), clock);
   if (scheme == "images") return open_images(fs::path(std::string(rest)), clock);
   throw CaptureError("source " + quoted + ": unknown scheme '" + std::string(scheme) +
                      "': " + std::string(kSpecHelp));

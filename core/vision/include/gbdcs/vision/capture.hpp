@@ -16,6 +16,10 @@
 // Specs for open_source()
 //   camera:N     OpenCV camera index N (V4L2 /dev/videoN on Linux); live.
 //   video:PATH   a video file OpenCV can decode (mp4, avi, mkv, ...); offline.
+//   video:PATH?live=1[&fps=N]
+//                the same file played as a camera (live): frame k is due k/fps after the
+//                first (the file's own rate, or N), looping forever; frames whose time has
+//                passed while the reader was busy are skipped, as a camera's are.
 //   images:DIR   the images in DIR (.jpg .jpeg .png .bmp .webp .tif .tiff), sorted by file
 //                name; offline; not recursive.
 // A source that cannot be opened throws CaptureError naming the source and the fix.
@@ -59,6 +63,12 @@ std::unique_ptr<CaptureSource> open_source(std::string_view spec, const contract
 std::unique_ptr<CaptureSource> open_camera(int index, const contracts::Clock& clock);
 std::unique_ptr<CaptureSource> open_video(const std::filesystem::path& path,
                                           const contracts::Clock& clock);
+// A video file played as a live camera (see video:PATH?live=1). `fps` <= 0: the file's own
+// rate (CaptureError if the file has none). `name`: what describe() says (default
+// "video:PATH?live=1"). Pacing: next() sleeps (real time) until its frame is due by `clock`.
+std::unique_ptr<CaptureSource> open_live_video(const std::filesystem::path& path,
+                                               const contracts::Clock& clock, double fps = 0,
+                                               std::string name = {});
 std::unique_ptr<CaptureSource> open_images(const std::filesystem::path& dir,
                                            const contracts::Clock& clock);
 
