@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -48,7 +49,9 @@ void render_fixture(const fs::path& recipe_path, const fs::path& out_dir,
   fs::create_directories(out_dir, ec);
   if (ec) throw std::runtime_error(out_dir.string() + ": cannot create the folder: " + ec.message());
   sim::FixtureRenderer renderer(recipe);
-  const fs::path video_tmp = out_dir / "video.partial.mp4";
+  // Per-process names: two processes may render the same recipe into the same cache at once.
+  const std::string tag = "partial." + std::to_string(::getpid());
+  const fs::path video_tmp = out_dir / ("video." + tag + ".mp4");
   std::vector<sim::FrameLabel> labels;
   {
     sim::VideoRecorderOptions vo;
@@ -63,7 +66,7 @@ void render_fixture(const fs::path& recipe_path, const fs::path& out_dir,
     }
     video.close();
   }
-  const fs::path labels_tmp = out_dir / "labels.partial.json";
+  const fs::path labels_tmp = out_dir / ("labels." + tag + ".json");
   {
     std::ofstream out(labels_tmp, std::ios::binary);
     out << renderer.labels_json(labels).dump(1) << "\n";
@@ -88,19 +91,50 @@ fs::path cached_fixture(const fs::path& recipe_path, const fs::path& cache_dir,
   return dir;
 }
 
+fs::path fixture_cache_dir() {
+  if (const char* env = std::getenv("GBDCS_FIXTURE_CACHE"); env && *env) return env;
+  std::error_code ec;
+  if (fs::is_directory(GBDCS_BUILD_DIR, ec)) return fs::path(GBDCS_BUILD_DIR) / "fixture-cache";
+  return fs::temp_directory_path(ec) / "gbdcs-fixture-cache";
+}
+
 std::unique_ptr<vision::CaptureSource> open_recipe_source(std::string_view spec,
-                                                          const contracts::Clock& clock) {
+                                                          const contracts::Clock& clock,
+                                                          const Progress& preparing) {
   std::string rest(spec.substr(7));  // after "recipe:"
   bool live = false;
+  bool cache = true;
   if (const auto q = rest.find('?'); q != std::string::npos) {
-    const std::string query = rest.substr(q + 1);
+    std::stringstream query(rest.substr(q + 1));
     rest = rest.substr(0, q);
-    if (query == "live=1" || query == "live=true") {
-      live = true;
-    } else if (query != "live=0" && query != "live=false") {
-      throw vision::CaptureError(std::string(spec) + ": unknown option \"" + query +
-                                 "\"; the only option is ?live=1");
+    for (std::string option; std::getline(query, option, '&');) {
+      if (option == "live=1" || option == "live=true") {
+        live = true;
+      } else if (option == "cache=0" || option == "cache=false") {
+        cache = false;
+      } else if (option != "live=0" && option != "live=false" && option != "cache=1" &&
+                 option != "cache=true") {
+        throw vision::CaptureError(std::string(spec) + ": unknown option \"" + option +
+                                   "\"; the options are live=1 and cache=0");
+      }
     }
+  }
+  if (live && cache) {
+    const fs::path recipe_path = sim::resolve_fixture_path(rest);
+    fs::path dir;
+    try {
+      dir = cached_fixture(recipe_path, fixture_cache_dir(), preparing);
+    } catch (const sim::RecipeError& e) {
+      throw vision::CaptureError(e.what());
+    } catch (const std::exception& e) {
+      throw vision::CaptureError(std::string(spec) + ": cannot render the recipe into " +
+                                 fixture_cache_dir().string() + ": " + e.what() +
+                                 " (set GBDCS_FIXTURE_CACHE to a writable folder, or add " +
+                                 "&cache=0 to render live)");
+    }
+    // The recipe's rate, not the container's (which may round it).
+    return vision::open_live_video(dir / "video.mp4", clock, sim::load_recipe(recipe_path).fps,
+                                   std::string(spec));
   }
   sim::Recipe recipe;
   try {

@@ -28,11 +28,21 @@ std::filesystem::path cached_fixture(const std::filesystem::path& recipe_path,
                                      const std::filesystem::path& cache_dir,
                                      const Progress& progress = {});
 
-// recipe:PATH[?live=1] as a capture source: rendered on the fly on the capture thread;
-// live=1 loops the recipe forever at its frame rate (a camera), otherwise the frames are
-// produced as fast as they are read and the stream ends with the recipe.
+// recipe:PATH[?live=1[&cache=0]] as a capture source.
+//   live=1    a camera: the recipe's video, rendered once into the fixture cache
+//             (fixture_cache_dir(); `preparing` is told the progress while it renders) and
+//             played back in a loop at the recipe's frame rate with real timing
+//             (vision::open_live_video), so the camera keeps its rate on a busy CPU.
+//   cache=0   with live=1: render every frame on the capture thread instead (no cache; the
+//             rate is whatever the CPU renders, ~17 FPS at 640x480 on two idle cores).
+//   neither   the frames rendered as fast as they are read; the stream ends with the recipe.
 std::unique_ptr<vision::CaptureSource> open_recipe_source(std::string_view spec,
-                                                          const contracts::Clock& clock);
+                                                          const contracts::Clock& clock,
+                                                          const Progress& preparing = {});
+
+// Where rendered recipes are cached for recipe:...?live=1: $GBDCS_FIXTURE_CACHE, else
+// <build dir>/fixture-cache when the build folder exists, else <tmp>/gbdcs-fixture-cache.
+std::filesystem::path fixture_cache_dir();
 
 // A progress bar on stderr when it is a terminal (nothing otherwise).
 Progress terminal_progress(std::string label);

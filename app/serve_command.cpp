@@ -221,13 +221,22 @@ int run_serve(ServeOptions o) {
              }
              return;
            }
+           if (msg["type"] == "picture") {
+             // The live feed's picture, at the camera's rate: shown, never acted on (commands
+             // come only from vision results, below).
+             http.metrics().feed_pictures++;
+             hub.broadcast("picture", {{"frame_id", msg["frame_id"]},
+                                       {"capture_time", msg["capture_time"]},
+                                       {"width", msg["width"]}, {"height", msg["height"]},
+                                       {"jpeg", msg["jpeg"]}});
+             return;
+           }
            http.metrics().vision_frames++;
            http.metrics().vision_latency_ms.observe(msg.value("latency_ms", 0.0));
            drone.on_vision_frame(msg);
            json data = {{"frame_id", msg["frame_id"]}, {"capture_time", msg["capture_time"]},
                         {"width", msg["width"]}, {"height", msg["height"]},
                         {"latency_ms", msg["latency_ms"]}, {"hands", msg["hands"]}};
-           if (msg.contains("jpeg")) data["jpeg"] = msg["jpeg"];
            hub.broadcast("frame", data);
          },
          [&] { supervisor->on_disconnected(); }});

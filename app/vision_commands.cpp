@@ -16,6 +16,8 @@
 #include "commands.hpp"
 #include "gbdcs/contracts/codec.hpp"
 #include "gbdcs/contracts/json_file.hpp"
+#include "fixture_support.hpp"
+#include "gbdcs/vision/feed_tap.hpp"
 #include "gbdcs/vision/model_files.hpp"
 #include "gbdcs/vision/vision_messages.hpp"
 #include "gbdcs/vision/vision_pipeline.hpp"
@@ -83,13 +85,30 @@ int run_vision(const VisionOptions& o) {
         contracts::read_json_file<std::runtime_error>(o.options_file, "pipeline options file"));
   std::unique_ptr<vision::CaptureSource> source;
   std::unique_ptr<vision::HandFinder> finder;
-  JpegTap* tap = nullptr;
+  // While a recipe camera's video is rendered into the cache (once): heartbeats that say so,
+  // not healthy (no take-off), so the supervisor knows the worker is alive.
+  auto last_note = clock.now() - contracts::from_seconds(o.heartbeat_s);
+  auto preparing = [&](std::int64_t done, std::int64_t total) {
+    if (clock.now() - last_note < contracts::from_seconds(o.heartbeat_s) && done < total) return;
+    last_note = clock.now();
+    vision::PipelineMetrics m;
+    m.healthy = false;
+    m.live = true;
+    m.source = o.source;
+    m.reason = "preparing the camera: rendering its video once into " +
+               fixture_cache_dir().string() + " (" + std::to_string(done) + " of " +
+               std::to_string(total) + " frames)";
+    emit(vision::heartbeat_message(m, clock.utc_now()));
+  };
   try {
-    source = open_any_source(o.source, clock);
+    source = o.source.rfind("recipe:", 0) == 0 ? open_recipe_source(o.source, clock, preparing)
+                                                : open_any_source(o.source, clock);
     if (o.publish_jpeg) {
-      auto wrapped = std::make_unique<JpegTap>(std::move(source), o.jpeg_width, 70);
-      tap = wrapped.get();
-      source = std::move(wrapped);
+      // The picture goes out at the camera's rate, apart from tracking (FeedTap's thread).
+      const int width = o.jpeg_width;
+      source = std::make_unique<vision::FeedTap>(std::move(source), [&emit, width](const vision::Frame& f) {
+        emit(picture_message(f, width, 70));
+      });
     }
     // A folder holds unrelated stills: detect in each (MediaPipe's static image mode).
     const bool stills = o.source.rfind("images:", 0) == 0;
@@ -104,13 +123,7 @@ int run_vision(const VisionOptions& o) {
 
   vision::VisionPipeline pipeline(
       std::move(source), std::move(finder), clock,
-      [&](const vision::FrameResult& r) {
-        auto doc = vision::frame_message(r);
-        if (tap) {
-          if (auto jpeg = tap->take(r.frame_id)) doc["jpeg"] = std::move(*jpeg);
-        }
-        emit(doc);
-      },
+      [&](const vision::FrameResult& r) { emit(vision::frame_message(r)); },
       options);
 
   pipeline.start();
@@ -306,13 +319,14 @@ void add_vision_commands(CLI::App& app) {
       "vision",
       "Run the vision pipeline (capture -> landmarks -> gesture) on a camera, video or image "
       "folder; prints JSON lines: a frame message per frame, a heartbeat every second");
-  vision_cmd->add_option("--source", v.source, "camera:N, video:PATH, images:DIR, recipe:PATH[?live=1] or tello:[ADDRESS][?...] (a Tello's own camera; docs/ADAPTERS.md)")->required();
+  vision_cmd->add_option("--source", v.source, "camera:N, video:PATH[?live=1], images:DIR, recipe:PATH[?live=1] or tello:[ADDRESS][?...] (a Tello's own camera; docs/ADAPTERS.md)")->required();
   add_model_options(vision_cmd, v.models);
   vision_cmd->add_option("--publish", v.publish,
                          "Send the messages to a WebSocket instead of stdout: "
                          "ws://127.0.0.1:PORT/worker?secret=S (what gbdcs serve passes)");
   vision_cmd->add_flag("--publish-jpeg", v.publish_jpeg,
-                       "Add a downscaled base64 JPEG of each frame to its frame message");
+                       "Also send each captured frame for the live feed as a picture message "
+                       "(downscaled base64 JPEG), at the camera's rate, apart from tracking");
   vision_cmd->add_option("--jpeg-width", v.jpeg_width, "Width of that JPEG, px")
       ->capture_default_str()
       ->check(CLI::Range(64, 1920));

@@ -14,39 +14,24 @@ namespace gbdcs::app {
 
 using nlohmann::json;
 
-JpegTap::JpegTap(std::unique_ptr<vision::CaptureSource> inner, int width_px, int quality)
-    : inner_(std::move(inner)), width_px_(width_px), quality_(quality) {}
-
-std::optional<vision::Frame> JpegTap::next() {
-  auto frame = inner_->next();
-  if (!frame || frame->rgb.empty()) return frame;
+json picture_message(const vision::Frame& frame, int width_px, int quality) {
   cv::Mat small, bgr;
-  const double scale = std::min(1.0, static_cast<double>(width_px_) / frame->rgb.cols);
-  cv::resize(frame->rgb, small, cv::Size(), scale, scale, cv::INTER_AREA);
-  if (frame->order == vision::PixelOrder::kRgb) {
+  const double scale = std::min(1.0, static_cast<double>(width_px) / frame.rgb.cols);
+  cv::resize(frame.rgb, small, cv::Size(), scale, scale, cv::INTER_AREA);
+  if (frame.order == vision::PixelOrder::kRgb) {
     cv::cvtColor(small, bgr, cv::COLOR_RGB2BGR);
   } else {
     bgr = small;
   }
   std::vector<unsigned char> bytes;
-  cv::imencode(".jpg", bgr, bytes, {cv::IMWRITE_JPEG_QUALITY, quality_});
-  auto b64 = server::base64_encode(std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
-  std::lock_guard lock(mutex_);
-  recent_.emplace_back(frame->frame_id, std::move(b64));
-  while (recent_.size() > 16) recent_.pop_front();
-  return frame;
-}
-
-std::optional<std::string> JpegTap::take(std::int64_t frame_id) {
-  std::lock_guard lock(mutex_);
-  for (auto it = recent_.begin(); it != recent_.end(); ++it) {
-    if (it->first == frame_id) {
-      auto out = std::move(it->second);
-      recent_.erase(recent_.begin(), it + 1);
-      return out;
-    }
-  }
-  return std::nullopt;
+  cv::imencode(".jpg", bgr, bytes, {cv::IMWRITE_JPEG_QUALITY, quality});
+  return {{"type", "picture"},
+          {"frame_id", frame.frame_id},
+          {"capture_time", contracts::format_utc(frame.capture_utc)},
+          {"width", bgr.cols},
+          {"height", bgr.rows},
+          {"jpeg", server::base64_encode(std::string_view(
+                       reinterpret_cast<const char*>(bytes.data()), bytes.size()))}};
 }
 
 int run_timeline_worker(const std::string& spec, double heartbeat_s, const Emit& emit,

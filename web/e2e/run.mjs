@@ -314,23 +314,61 @@ async function main() {
     await page.getByRole('button', { name: 'Release emergency stop' }).click();
 
     if (fpsSeconds > 0) {
-      await page.evaluate(() => (window.__gbdcsFeed.drawn = 0));
+      // Counted in the page (pictures and results received, distinct pictures drawn, the
+      // worker's vision FPS sampled from the state messages each second) and at the server
+      // (pictures broadcast, vision results received: /metrics).
+      const metric = async (name) => {
+        const text = await fetch(`${base}/api/v1/metrics`).then((r) => r.text());
+        const line = text.split('\n').find((l) => l.startsWith(`${name} `));
+        return line ? Number(line.split(' ')[1]) : NaN;
+      };
+      const counts = () =>
+        page.evaluate(() => ({
+          drawn: window.__gbdcsFeed.drawn,
+          results: window.__gbdcs.frames.received,
+          pictures: window.__gbdcs.frames.pictures.received,
+        }));
+      const c0 = await counts();
+      const sent0 = await metric('gbdcs_feed_pictures_total');
+      const vision0 = await metric('gbdcs_vision_frames_total');
       const t0 = Date.now();
-      const received0 = await page.evaluate(() => window.__gbdcs.frames.received);
-      await page.waitForTimeout(fpsSeconds * 1000);
-      const r = await page.evaluate(() => ({
-        drawn: window.__gbdcsFeed.drawn,
-        received: window.__gbdcs.frames.received,
-      }));
+      const visionFps = [];
+      const lags = [];
+      const states = {};
+      while (Date.now() - t0 < fpsSeconds * 1000) {
+        await page.waitForTimeout(1000);
+        const v = await page.evaluate(() => ({
+          fps: window.__gbdcs.live.server?.vision?.fps ?? null,
+          lag: window.__gbdcsFeed.skeletonLagMs,
+          state: window.__gbdcsFeed.skeleton,
+        }));
+        if (v.fps !== null) visionFps.push(v.fps);
+        if (v.lag !== null) lags.push(v.lag);
+        states[v.state] = (states[v.state] ?? 0) + 1;
+      }
+      const c1 = await counts();
+      const sent1 = await metric('gbdcs_feed_pictures_total');
+      const vision1 = await metric('gbdcs_vision_frames_total');
       const s = (Date.now() - t0) / 1000;
+      const rate = (n) => Number((n / s).toFixed(2));
+      const sorted = [...lags].sort((x, y) => x - y);
       const result = {
         window_s: Number(s.toFixed(1)),
-        feed_fps_drawn: Number((r.drawn / s).toFixed(2)),
-        feed_fps_received: Number(((r.received - received0) / s).toFixed(2)),
+        feed_fps_drawn: rate(c1.drawn - c0.drawn),
+        feed_pictures_fps_received: rate(c1.pictures - c0.pictures),
+        feed_pictures_fps_sent: rate(sent1 - sent0),
+        vision_results_fps_received_by_server: rate(vision1 - vision0),
+        vision_results_fps_received: rate(c1.results - c0.results),
+        vision_fps_mean_reported: visionFps.length
+          ? Number((visionFps.reduce((x, y) => x + y, 0) / visionFps.length).toFixed(2))
+          : null,
+        skeleton_lag_ms_p50: sorted.length ? sorted[Math.floor(sorted.length / 2)] : null,
+        skeleton_lag_ms_max: sorted.length ? sorted[sorted.length - 1] : null,
+        skeleton_states_sampled: states,
       };
       writeFileSync(join(out, 'feed_fps.json'), JSON.stringify(result, null, 2) + '\n');
       log(
-        `feed over ${result.window_s} s: ${result.feed_fps_drawn} FPS drawn, ${result.feed_fps_received} FPS received`,
+        `feed over ${result.window_s} s: ${result.feed_fps_drawn} FPS drawn, ${result.feed_pictures_fps_received} pictures/s received (${result.feed_pictures_fps_sent} sent), vision ${result.vision_results_fps_received} results/s`,
       );
     }
 

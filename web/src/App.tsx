@@ -91,6 +91,10 @@ export function App() {
           frames.push(msg.data);
           return;
         }
+        if (msg.type === 'picture') {
+          frames.pictures.push(msg.data);
+          return;
+        }
         if (msg.type === 'drone_view') {
           views.push(msg.data);
           return;

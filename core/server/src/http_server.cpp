@@ -292,7 +292,10 @@ class WorkerSession final : public std::enable_shared_from_this<WorkerSession> {
       try {
         auto doc = contracts::parse_json(text);
         const auto type = doc.value("type", "");
-        contracts::validate(type == "heartbeat" ? "vision_heartbeat" : "vision_frame", doc);
+        contracts::validate(type == "heartbeat"  ? "vision_heartbeat"
+                            : type == "picture" ? "vision_picture"
+                                                : "vision_frame",
+                            doc);
         if (h.message) h.message(doc);
       } catch (const std::exception& e) {
         if (self->impl_.log) self->impl_.log("warn", {{"event", "worker_bad_message"}, {"cause", e.what()}});

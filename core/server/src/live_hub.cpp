@@ -7,7 +7,7 @@
 namespace gbdcs::server {
 
 MessageClass class_of(std::string_view type) {
-  if (type == "frame" || type == "drone_view") return MessageClass::kFrame;
+  if (type == "frame" || type == "picture" || type == "drone_view") return MessageClass::kFrame;
   if (type == "telemetry") return MessageClass::kTelemetry;
   if (type == "alert" || type == "ack_result" || type == "error") return MessageClass::kNeverDrop;
   return MessageClass::kOther;

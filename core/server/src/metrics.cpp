@@ -90,6 +90,8 @@ std::string Metrics::render() const {
     }
   }
   counter("gbdcs_vision_frames_total", "Frames received from the vision worker", vision_frames);
+  counter("gbdcs_feed_pictures_total", "Camera pictures broadcast to /ws/live for the live feed",
+          feed_pictures);
   counter("gbdcs_vision_worker_restarts_total", "Vision worker restarts", worker_restarts);
   counter("gbdcs_alerts_total", "Alerts raised", alerts);
   counter("gbdcs_commands_total", "Commands with an outcome", commands);

@@ -12,6 +12,7 @@ const SERVER_TYPES = new Set([
   'command',
   'state',
   'frame',
+  'picture',
   'drone_view',
   'ack_result',
   'error',

@@ -330,8 +330,6 @@ export type VisionFrame = {
     gesture: "NONE" | "OPEN_PALM" | "FIST" | "THUMB_UP" | "THUMB_DOWN" | "POINT_LEFT" | "POINT_RIGHT" | "POINT_UP" | "VICTORY" | "I_LOVE_YOU";
     confidence: number;
   }>;
-  /** base64 JPEG of the frame, downscaled for the live feed; only with `gbdcs vision --publish-jpeg` */
-  jpeg?: string;
   /** the GestureEngine's event for this frame (onset or refresh), or null */
   gesture_event: null | GestureEvent;
 };
@@ -401,6 +399,21 @@ export type VisionHeartbeat = {
       dropped: number;
     };
   };
+};
+
+/** A captured camera frame for the live feed, from the vision worker (`gbdcs vision --publish-jpeg`), sent at the camera's rate whatever tracking manages; its hands come later in the `frame` message with the same frame_id (or not at all when tracking dropped the frame).
+ * Schema: core/contracts/schemas/vision_picture.schema.json */
+export type VisionPicture = {
+  type: "picture";
+  /** the source's frame id (the same numbering as vision_frame) */
+  frame_id: number;
+  /** UTC when the source produced the frame, ISO 8601 with milliseconds and Z */
+  capture_time: string;
+  /** px of the JPEG */
+  width: number;
+  height: number;
+  /** base64 JPEG (no data: prefix), downscaled for the feed */
+  jpeg: string;
 };
 
 /** Client -> server: acknowledge an alert (data.id of an alert message).
@@ -515,7 +528,7 @@ export type WsErrorMessage = {
   data: WsErrorData;
 };
 
-/** One camera frame for the live feed: the downscaled JPEG (base64) when the worker sends pixels, and the hands found on it.
+/** One vision result for the live feed: the hands found on a camera frame (the skeleton), with that frame's id and capture time. The picture itself comes in `picture` messages at the camera's rate; a dashboard draws this skeleton over the newest picture and says how far it lags.
  * Schema: core/contracts/schemas/ws_frame_data.schema.json */
 export type WsFrameData = {
   frame_id: number;
@@ -524,12 +537,10 @@ export type WsFrameData = {
   width: number;
   height: number;
   latency_ms: number;
-  /** base64 JPEG (no data: prefix); absent for landmark-only sources */
-  jpeg?: string;
   hands: VisionHand[];
 };
 
-/** A camera frame for the live feed (>= 24 FPS when the camera gives them).
+/** A vision result (the hands on one camera frame) for the live feed's skeleton.
  * Schema: core/contracts/schemas/ws_frame_message.schema.json */
 export type WsFrameMessage = {
   type: "frame";
@@ -559,9 +570,33 @@ export type WsInput = {
   pressed: boolean;
 };
 
+/** One camera picture for the live feed, sent at the camera's rate; the skeleton to draw over it comes from the newest `frame` message (compare capture times to know how far it lags).
+ * Schema: core/contracts/schemas/ws_picture_data.schema.json */
+export type WsPictureData = {
+  frame_id: number;
+  /** UTC, ISO 8601 with milliseconds and Z */
+  capture_time: string;
+  /** px of the JPEG */
+  width: number;
+  height: number;
+  /** base64 JPEG (no data: prefix) */
+  jpeg: string;
+};
+
+/** A camera picture for the live feed, at the camera's rate (>= 24 FPS when the camera gives them).
+ * Schema: core/contracts/schemas/ws_picture_message.schema.json */
+export type WsPictureMessage = {
+  type: "picture";
+  /** UTC, ISO 8601 with milliseconds and Z */
+  ts: string;
+  /** true when the message comes from a stored session being replayed */
+  replay?: boolean;
+  data: WsPictureData;
+};
+
 /** Every message the server sends on /ws/live: {type, ts, replay?, data}.
  * Schema: core/contracts/schemas/ws_server_message.schema.json */
-export type WsServerMessage = WsGestureMessage | WsTelemetryMessage | WsAlertMessage | WsCommandMessage | WsStateMessage | WsFrameMessage | WsDroneViewMessage | WsAckResultMessage | WsErrorMessage;
+export type WsServerMessage = WsGestureMessage | WsTelemetryMessage | WsAlertMessage | WsCommandMessage | WsStateMessage | WsFrameMessage | WsPictureMessage | WsDroneViewMessage | WsAckResultMessage | WsErrorMessage;
 
 /** The server's view of the drone, the vision worker and replays: sent on connect and whenever it changes (at least every 2 s).
  * Schema: core/contracts/schemas/ws_state_data.schema.json */

@@ -1,6 +1,6 @@
 // The latest picture (camera frame, drone view) outside React state: the canvas or image that
 // shows it pulls or subscribes to it, so 24-30 FPS of JPEGs never re-render the panels.
-import type { WsDroneViewData, WsFrameData } from '../types';
+import type { WsDroneViewData, WsFrameData, WsPictureData } from '../types';
 
 type Listener<T> = (f: T) => void;
 
@@ -25,8 +25,18 @@ export class LatestBus<T> {
   }
 }
 
-/** Camera frames for the live feed. */
-export class FrameBus extends LatestBus<WsFrameData> {}
+/**
+ * The live feed: vision results (hands, at tracking's rate) and, apart, camera pictures (at
+ * the camera's rate); the feed draws the newest result's skeleton over the newest picture.
+ */
+export class FrameBus extends LatestBus<WsFrameData> {
+  readonly pictures = new LatestBus<WsPictureData>();
+
+  override clear(): void {
+    super.clear();
+    this.pictures.clear();
+  }
+}
 
 /** Pictures of the drone from its adapter (the twin's chase camera). */
 export class ViewBus extends LatestBus<WsDroneViewData> {}

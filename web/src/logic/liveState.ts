@@ -163,6 +163,7 @@ function onMessage(state: LiveState, msg: WsServerMessage, nowMs: number): LiveS
     case 'error':
       return { ...base, lastError: msg.data };
     case 'frame':
+    case 'picture':
     case 'drone_view':
       return base;
   }

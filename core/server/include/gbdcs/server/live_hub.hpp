@@ -2,7 +2,7 @@
 // queue, so a slow client never slows the others or the control loop.
 //
 //   ClientQueue  the per-client policy (plain logic, unit-tested): capacity `soft_limit`
-//                (256); when full, drop the oldest frame (or drone_view), else the oldest telemetry, else the
+//                (256); when full, drop the oldest frame (picture, frame or drone_view), else the oldest telemetry, else the
 //                oldest other droppable message (gesture, command, state). Alerts, ack_result
 //                and error are never dropped; past `hard_limit` (1024) of those the client is
 //                too slow to be safe and is disconnected.

@@ -40,6 +40,7 @@ class Metrics {
   Histogram vision_latency_ms;
   Histogram ws_delivery_ms;
   std::atomic<std::uint64_t> vision_frames{0};
+  std::atomic<std::uint64_t> feed_pictures{0};  // camera pictures broadcast for the live feed
   std::atomic<std::uint64_t> worker_restarts{0};
   std::atomic<std::uint64_t> alerts{0};
   std::atomic<std::uint64_t> commands{0};
