@@ -108,6 +108,7 @@ async function main() {
     { cwd: repo, env: { ...process.env }, stdio: ['ignore', 'pipe', 'pipe'] },
   );
   let browser;
+  let page;
   const shots = [];
   try {
     const base = await new Promise((res, rej) => {
@@ -142,7 +143,7 @@ async function main() {
         '--autoplay-policy=no-user-gesture-required',
       ],
     });
-    const page = await browser.newPage({ viewport: { width: 1366, height: 900 } });
+    page = await browser.newPage({ viewport: { width: 1366, height: 900 } });
     const errors = [];
     page.on('pageerror', (e) => errors.push(e.message));
     const sockets = [];
@@ -402,6 +403,10 @@ async function main() {
 
     if (errors.length) fail(`errors in the page: ${errors.join('; ')}`);
     log(`PASS (${shots.length} screenshots in ${out})`);
+  } catch (e) {
+    // What the page showed when a step failed.
+    await page?.screenshot({ path: join(out, 'failed.png') }).catch(() => {});
+    throw e;
   } finally {
     await browser?.close().catch(() => {});
     child.kill('SIGTERM');
