@@ -176,11 +176,30 @@ TEST(ServerWorker, SecretRequiredAndBadMessagesAreDroppedNotFatal) {
   worker.send(wrong_type.dump());
   worker.send(json{{"type", "heartbeat"}, {"fps", "fast"}}.dump());
   worker.send(json::array({1, 2, 3}).dump());
+  // The live feed's picture: checked against vision_picture (a JPEG is required).
+  const json picture = {{"type", "picture"}, {"frame_id", 8},
+                        {"capture_time", "2026-01-01T00:00:00.033Z"}, {"width", 480},
+                        {"height", 360}, {"jpeg", "AA=="}};
+  auto no_jpeg = picture;
+  no_jpeg.erase("jpeg");
+  worker.send(no_jpeg.dump());
+  auto frame_with_pixels = good;  // pixels travel only in pictures now
+  frame_with_pixels["jpeg"] = "AA==";
+  worker.send(frame_with_pixels.dump());
   worker.send(good.dump());
+  worker.send(picture.dump());
   std::unique_lock lock(m);
-  ASSERT_TRUE(cv.wait_for(lock, 10s, [&] { return !got.empty(); }));
-  ASSERT_EQ(got.size(), 1u) << "only the valid frame gets through";
+  ASSERT_TRUE(cv.wait_for(lock, 10s, [&] { return got.size() >= 2; }));
+  ASSERT_EQ(got.size(), 2u) << "only the valid frame and picture get through";
   EXPECT_EQ(got[0]["frame_id"], 7);
+  EXPECT_EQ(got[1]["type"], "picture");
+  EXPECT_EQ(got[1]["frame_id"], 8);
+}
+
+TEST(ClientQueue, PicturesAreDroppedFirstLikeFrames) {
+  EXPECT_EQ(class_of("picture"), MessageClass::kFrame);
+  EXPECT_EQ(class_of("frame"), MessageClass::kFrame);
+  EXPECT_EQ(class_of("alert"), MessageClass::kNeverDrop);
 }
 
 TEST(ClientQueue, DropsFramesThenTelemetryNeverAlerts) {
