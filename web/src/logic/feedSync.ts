@@ -5,8 +5,8 @@
 //   current  lag <= SKELETON_CURRENT_MS (a few camera frames): drawn as is
 //   lagging  lag <= SKELETON_STALE_MS: drawn dashed, and the page says by how much it lags
 //   stale    older: not drawn; the page says tracking is behind (never a stale skeleton as current)
-// SKELETON_STALE_MS is the server's vision-freshness limit: a result that old no longer
-// steers the drone either.
+// SKELETON_STALE_MS is the server's vision_stale_s: with no result for that long vision counts
+// as unhealthy and the failsafe hovers.
 
 export const SKELETON_CURRENT_MS = 100;
 export const SKELETON_STALE_MS = 500;
