@@ -3,7 +3,6 @@
 // back as a recorded video + labels gives the same flight again, and a missing or broken
 // recipe, video or labels file is named with its field and the fix.
 #include <gtest/gtest.h>
-
 #include <unistd.h>
 
 #include <filesystem>
@@ -108,10 +107,10 @@ TEST_F(PixelCameraTest, RecipeCameraIsDeterministicAndMatchesItsRecording) {
   fs::path rendered;
   for (const auto& e : fs::directory_iterator(dir_ / "cache")) rendered = e.path();
   ASSERT_TRUE(fs::exists(rendered / "labels.json")) << rendered;
-  const auto recorded = run_scenario(
-      Scenario::from_json(scenario({{"video", (rendered / "video.mp4").string()},
-                                    {"labels", (rendered / "labels.json").string()}})),
-      options());
+  const auto recorded =
+      run_scenario(Scenario::from_json(scenario({{"video", (rendered / "video.mp4").string()},
+                                                 {"labels", (rendered / "labels.json").string()}})),
+                   options());
   ASSERT_TRUE(recorded.error.empty()) << recorded.error;
   expect_same_flight(first, recorded);
 }
@@ -141,8 +140,8 @@ TEST_F(PixelCameraTest, MissingFilesNameTheFieldAndTheFix) {
   EXPECT_NE(e.find("no such file"), std::string::npos) << e;
   EXPECT_NE(e.find("give the path of a fixture recipe"), std::string::npos) << e;
 
-  e = load_error(scenario({{"video", (dir_ / "none.mp4").string()},
-                           {"labels", (dir_ / "hop.json").string()}}));
+  e = load_error(scenario(
+      {{"video", (dir_ / "none.mp4").string()}, {"labels", (dir_ / "hop.json").string()}}));
   EXPECT_NE(e.find("camera.video"), std::string::npos) << e;
   EXPECT_NE(e.find("recorded fixture folder"), std::string::npos) << e;
 
@@ -151,15 +150,15 @@ TEST_F(PixelCameraTest, MissingFilesNameTheFieldAndTheFix) {
   EXPECT_NE(e.find("camera.labels"), std::string::npos) << e;
   EXPECT_NE(e.find("labels.json"), std::string::npos) << e;
 
-  e = load_error(scenario({{"video", (dir_ / "video.mp4").string()},
-                           {"labels", (dir_ / "labels.json").string()}}));
+  e = load_error(scenario(
+      {{"video", (dir_ / "video.mp4").string()}, {"labels", (dir_ / "labels.json").string()}}));
   EXPECT_NE(e.find("camera.labels"), std::string::npos) << e;
   EXPECT_NE(e.find("no such file"), std::string::npos) << e;
 
   // Files that exist but are not what they claim: the run fails naming the field.
   std::ofstream(dir_ / "labels.json") << R"({"format": "something else"})";
-  auto r = run_error(scenario({{"video", (dir_ / "video.mp4").string()},
-                                            {"labels", (dir_ / "labels.json").string()}}));
+  auto r = run_error(scenario(
+      {{"video", (dir_ / "video.mp4").string()}, {"labels", (dir_ / "labels.json").string()}}));
   EXPECT_NE(r.find("camera.labels"), std::string::npos) << r;
   EXPECT_NE(r.find("gbdcs fixture check"), std::string::npos) << r;
 

@@ -146,19 +146,17 @@ class PixelCamera final : public ScenarioCamera {
 std::unique_ptr<ScenarioCamera> open_pixel_camera(const CameraSpec& spec,
                                                   const CameraOptions& options) {
   if (spec.kind == CameraKind::kRecipe) {
-    const fs::path cache =
-        options.fixture_cache_dir.empty() ? default_fixture_cache_dir()
-                                          : fs::path(options.fixture_cache_dir);
+    const fs::path cache = options.fixture_cache_dir.empty() ? default_fixture_cache_dir()
+                                                             : fs::path(options.fixture_cache_dir);
     fs::path dir;
     try {
       dir = cached_fixture(spec.path, cache);
     } catch (const RecipeError& e) {
       throw std::invalid_argument("camera.recipe: " + std::string(e.what()));
     }
-    return std::make_unique<PixelCamera>((dir / "video.mp4").string(),
-                                         (dir / "labels.json").string(), 0,
-                                         "recipe '" + fs::path(spec.path).stem().string() + "'",
-                                         options);
+    return std::make_unique<PixelCamera>(
+        (dir / "video.mp4").string(), (dir / "labels.json").string(), 0,
+        "recipe '" + fs::path(spec.path).stem().string() + "'", options);
   }
   return std::make_unique<PixelCamera>(spec.path, spec.labels_path, spec.fps,
                                        "video '" + spec.path + "'", options);
