@@ -96,7 +96,7 @@ class PixelCamera final : public ScenarioCamera {
       rgb = frame->rgb;
       cv::cvtColor(frame->rgb, f.image, cv::COLOR_RGB2BGR);
     }
-    f.hand = strongest(finder_->find(rgb));
+    f.hand = vision::strongest_hand(finder_->find(rgb));
     return f;
   }
 
@@ -119,18 +119,6 @@ class PixelCamera final : public ScenarioCamera {
   std::string describe() const override { return name_; }
 
  private:
-  // The pipeline's classify stage and the server's best_hand(): the highest presence wins,
-  // the first on a tie.
-  static std::optional<contracts::Landmarks> strongest(
-      const std::vector<contracts::Landmarks>& hands) {
-    const contracts::Landmarks* best = nullptr;
-    for (const auto& h : hands) {
-      if (best == nullptr || h.score > best->score) best = &h;
-    }
-    if (best == nullptr) return std::nullopt;
-    return *best;
-  }
-
   contracts::SteadyClock wall_;  // the tracker's stage timings only; results never read it
   json labels_;
   std::string name_;
