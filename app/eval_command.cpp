@@ -19,6 +19,7 @@
 #include "commands.hpp"
 #include "fixture_support.hpp"
 #include "gbdcs/contracts/codec.hpp"
+#include "gbdcs/sim/fixture_cache.hpp"
 #include "gbdcs/vision/model_files.hpp"
 #include "gbdcs/vision/vision_pipeline.hpp"
 #include "vision_support.hpp"
@@ -454,7 +455,7 @@ int run_eval(const EvalOptions& o) {
     }
   }
   if (!recipes.empty()) {
-    const fs::path cache = o.cache_dir.empty() ? fs::temp_directory_path() / "gbdcs-fixture-cache"
+    const fs::path cache = o.cache_dir.empty() ? sim::default_fixture_cache_dir()
                                                : fs::path(o.cache_dir);
     for (const auto& r : recipes) {
       fixtures.push_back(cached_fixture(r, cache, terminal_progress("render " + r.stem().string())));

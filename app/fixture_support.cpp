@@ -10,85 +10,24 @@
 #include <sstream>
 #include <thread>
 
+#include "gbdcs/sim/fixture_cache.hpp"
 #include "gbdcs/sim/fixture_renderer.hpp"
 #include "gbdcs/sim/hand_scene.hpp"
 #include "gbdcs/sim/recipe.hpp"
-#include "gbdcs/sim/video_recorder.hpp"
 
 namespace gbdcs::app {
-namespace {
 
 namespace fs = std::filesystem;
 
-// Bump when the renderer or the pose library changes what a recipe renders to (invalidates
-// caches: the key covers the recipe and hand.xml, not the code). 2: RELAXED and WAVING at the
-// rest cascade.
-constexpr std::string_view kRendererVersion = "fixture-renderer/2";
-
-std::uint64_t fnv1a(std::string_view text, std::uint64_t h = 1469598103934665603ULL) {
-  for (unsigned char c : text) {
-    h ^= c;
-    h *= 1099511628211ULL;
-  }
-  return h;
+void render_fixture(const std::filesystem::path& recipe_path,
+                    const std::filesystem::path& out_dir, const Progress& progress) {
+  sim::render_fixture(recipe_path, out_dir, progress);
 }
 
-std::string read_text(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-}  // namespace
-
-void render_fixture(const fs::path& recipe_path, const fs::path& out_dir,
-                    const Progress& progress) {
-  sim::Recipe recipe = sim::load_recipe(recipe_path);
-  std::error_code ec;
-  fs::create_directories(out_dir, ec);
-  if (ec) throw std::runtime_error(out_dir.string() + ": cannot create the folder: " + ec.message());
-  sim::FixtureRenderer renderer(recipe);
-  // Per-process names: two processes may render the same recipe into the same cache at once.
-  const std::string tag = "partial." + std::to_string(::getpid());
-  const fs::path video_tmp = out_dir / ("video." + tag + ".mp4");
-  std::vector<sim::FrameLabel> labels;
-  {
-    sim::VideoRecorderOptions vo;
-    vo.fps = recipe.fps;
-    sim::VideoRecorder video(video_tmp, cv::Size(recipe.width, recipe.height), vo);
-    const auto n = renderer.frame_count();
-    for (std::int64_t i = 0; i < n; ++i) {
-      auto frame = renderer.frame(i);
-      video.write(frame.bgr);
-      labels.push_back(std::move(frame.label));
-      if (progress) progress(i + 1, n);
-    }
-    video.close();
-  }
-  const fs::path labels_tmp = out_dir / ("labels." + tag + ".json");
-  {
-    std::ofstream out(labels_tmp, std::ios::binary);
-    out << renderer.labels_json(labels).dump(1) << "\n";
-    if (!out) throw std::runtime_error(labels_tmp.string() + ": cannot write (disk full?)");
-  }
-  // The labels last: a folder with labels.json is complete.
-  fs::rename(video_tmp, out_dir / "video.mp4");
-  fs::rename(labels_tmp, out_dir / "labels.json");
-}
-
-fs::path cached_fixture(const fs::path& recipe_path, const fs::path& cache_dir,
-                        const Progress& progress) {
-  const sim::Recipe recipe = sim::load_recipe(recipe_path);
-  std::uint64_t h = fnv1a(sim::to_json(recipe).dump());
-  h = fnv1a(read_text(sim::default_hand_model_path()), h);
-  h = fnv1a(kRendererVersion, h);
-  char hex[17];
-  std::snprintf(hex, sizeof(hex), "%016llx", static_cast<unsigned long long>(h));
-  const fs::path dir = cache_dir / (recipe_path.stem().string() + "-" + std::string(hex, 12));
-  if (fs::exists(dir / "labels.json") && fs::exists(dir / "video.mp4")) return dir;
-  render_fixture(recipe_path, dir, progress);
-  return dir;
+std::filesystem::path cached_fixture(const std::filesystem::path& recipe_path,
+                                     const std::filesystem::path& cache_dir,
+                                     const Progress& progress) {
+  return sim::cached_fixture(recipe_path, cache_dir, progress);
 }
 
 fs::path fixture_cache_dir() {

@@ -17,7 +17,9 @@ namespace gbdcs::app {
 using Progress = std::function<void(std::int64_t, std::int64_t)>;
 
 // Renders the recipe at `recipe_path` into `out_dir` (created): video.mp4 and labels.json.
-// Throws sim::RecipeError for a bad recipe, std::runtime_error for I/O failures.
+// Throws sim::RecipeError for a bad recipe, std::runtime_error for I/O failures. Both this and
+// cached_fixture live in sim/fixtures (gbdcs/sim/fixture_cache.hpp), which the scenario
+// runner shares.
 void render_fixture(const std::filesystem::path& recipe_path, const std::filesystem::path& out_dir,
                     const Progress& progress = {});
 

@@ -17,6 +17,7 @@
 #include "gbdcs/sim/scenario.hpp"
 #include "gbdcs/sim/scenario_report.hpp"
 #include "gbdcs/sim/scenario_runner.hpp"
+#include "vision_support.hpp"
 
 namespace gbdcs::app {
 namespace {
@@ -31,6 +32,8 @@ struct ScenarioCmdOptions {
   int jobs = 1;
   std::string failsafe;
   bool quiet_table = false;
+  std::string cache;
+  ModelChoice models;
 };
 
 std::vector<std::string> expand(const std::vector<std::string>& paths) {
@@ -54,6 +57,9 @@ void write_file(const std::string& path, const std::string& text) {
 int run_scenarios(const ScenarioCmdOptions& o) {
   const auto files = expand(o.paths);
   sim::RunOptions ro;
+  ro.fixture_cache_dir = o.cache;
+  ro.model = o.models.model;
+  ro.model_dir = o.models.model_dir;
   if (!o.out.empty()) {
     ro.artifacts_dir = o.out;
     ro.artifacts_always = true;
@@ -150,6 +156,10 @@ void add_scenario_command(CLI::App& app) {
   run->add_option("--failsafe", o.failsafe,
                   "JSON merged over every scenario's failsafe options, to check that the suite "
                   "catches a broken build (e.g. '{\"idle_timeout_s\": 30}')");
+  run->add_option("--cache", o.cache,
+                  "Folder where recipe cameras are rendered once and kept (the cache `gbdcs "
+                  "eval --cache` uses; default: <temp>/gbdcs-fixture-cache)");
+  add_model_options(run, o.models);
   run->callback([] {
     try {
       g_exit_code = run_scenarios(o);

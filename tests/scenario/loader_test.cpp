@@ -52,8 +52,13 @@ bool schema_accepts(const nlohmann::json& doc) {
 }
 
 TEST(ScenarioLoader, EverySuiteFileLoadsAndMatchesTheSchema) {
-  const auto files = scenario_files(std::string(GBDCS_SOURCE_DIR) + "/scenarios");
+  auto files = scenario_files(std::string(GBDCS_SOURCE_DIR) + "/scenarios");
   ASSERT_GE(files.size(), 1u);
+  // Kept out of ctest until issue 5 lands, but they must stay valid.
+  const auto blocked =
+      scenario_files(std::string(GBDCS_SOURCE_DIR) + "/scenarios/blocked_by_issue_5");
+  EXPECT_GE(blocked.size(), 3u);
+  files.insert(files.end(), blocked.begin(), blocked.end());
   for (const auto& f : files) {
     SCOPED_TRACE(f);
     EXPECT_NO_THROW((void)Scenario::load_file(f));

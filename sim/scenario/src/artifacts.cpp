@@ -87,7 +87,7 @@ cv::Mat hand_panel(const VideoSnapshot& v) {
   } else {
     panel = cv::Mat(kPanelH, kPanelW, CV_8UC3, cv::Scalar(40, 36, 32));
   }
-  if (v.hand && v.jpeg.empty()) {
+  if (v.hand) {  // the timeline's landmarks, or what the tracker found on the pixels
     auto px = [&](std::size_t i) {
       return cv::Point(static_cast<int>(v.hand->points[i].x * kPanelW),
                        static_cast<int>(v.hand->points[i].y * kPanelH));

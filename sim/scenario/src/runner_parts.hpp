@@ -36,8 +36,19 @@ class ScenarioCamera {
   virtual std::string describe() const = 0;
 };
 
+// What a pixel camera needs besides its spec: where rendered recipes are cached and which
+// hand models the vision stages load.
+struct CameraOptions {
+  std::string fixture_cache_dir;  // empty: sim::default_fixture_cache_dir()
+  bool full_model = true;         // the models `gbdcs serve`'s vision worker loads by default
+  std::string model_dir;          // empty: vision::default_model_dir()
+};
+
 std::unique_ptr<ScenarioCamera> open_scenario_camera(const CameraSpec& spec,
-                                                     const contracts::Clock& clock);
+                                                     const CameraOptions& options);
+// recipe and video + labels (pixel_camera.cpp).
+std::unique_ptr<ScenarioCamera> open_pixel_camera(const CameraSpec& spec,
+                                                  const CameraOptions& options);
 
 // The drone of a scenario and the faults it can take.
 class ScenarioDrone {

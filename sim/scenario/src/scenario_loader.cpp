@@ -110,14 +110,30 @@ CameraSpec read_camera(Fields& f, const std::string& base_dir) {
   } else if (has_recipe) {
     c.kind = CameraKind::kRecipe;
     c.path = resolve(base_dir, g.string("recipe"));
-    if (!fs::exists(c.path)) g.fail("recipe", "no such file '" + c.path + "'");
+    if (!fs::is_regular_file(c.path)) {
+      g.fail("recipe", "no such file '" + c.path +
+                           "'; give the path of a fixture recipe (fixtures/recipes/*.json, "
+                           "docs/FIXTURES.md), relative to the scenario file");
+    }
   } else {
     c.kind = CameraKind::kRecorded;
     c.path = resolve(base_dir, g.string("video"));
-    if (!fs::exists(c.path)) g.fail("video", "no such file '" + c.path + "'");
+    if (!fs::is_regular_file(c.path)) {
+      g.fail("video", "no such file '" + c.path +
+                          "'; give the video.mp4 of a recorded fixture folder (`gbdcs fixture "
+                          "record` or `gbdcs fixture render`), relative to the scenario file");
+    }
+    if (!g.has("labels")) {
+      g.fail("labels", "missing; a video needs the labels.json of its fixture folder (the "
+                       "segment truth the criteria are judged against)");
+    }
     c.labels_path = resolve(base_dir, g.string("labels"));
-    if (!fs::exists(c.labels_path)) g.fail("labels", "no such file '" + c.labels_path + "'");
-    c.fps = g.opt_number("fps", 1, 240).value_or(30);
+    if (!fs::is_regular_file(c.labels_path)) {
+      g.fail("labels", "no such file '" + c.labels_path +
+                           "'; give the labels.json beside the video, relative to the scenario "
+                           "file");
+    }
+    c.fps = g.opt_number("fps", 1, 240).value_or(0);
   }
   if (c.kind != CameraKind::kRecorded) {
     if (g.has("labels")) g.fail("labels", "only a recorded video takes labels");

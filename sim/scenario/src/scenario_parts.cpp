@@ -1,4 +1,5 @@
-// The scenario's drones (twin, dummy) and cameras (gesture timelines).
+// The scenario's drones (twin, dummy) and landmark cameras (gesture timelines); the pixel
+// cameras are in pixel_camera.cpp.
 #include <mutex>
 #include <stdexcept>
 
@@ -165,11 +166,9 @@ std::unique_ptr<ScenarioDrone> make_scenario_drone(const Scenario& s, const cont
 }
 
 std::unique_ptr<ScenarioCamera> open_scenario_camera(const CameraSpec& spec,
-                                                     const contracts::Clock&) {
+                                                     const CameraOptions& options) {
   if (spec.kind == CameraKind::kTimeline) return std::make_unique<TimelineCamera>(spec);
-  throw std::invalid_argument("camera '" + std::string(to_string(spec.kind)) +
-                              "' is not available in this build yet (the fixture renderer has "
-                              "not landed); use a timeline");
+  return open_pixel_camera(spec, options);
 }
 
 }  // namespace gbdcs::sim::detail

@@ -125,7 +125,11 @@ ScenarioResult run_scenario(const Scenario& s, const RunOptions& options) {
   contracts::ManualClock clock;
   auto model = detail::shared_twin_model();
   auto drone = detail::make_scenario_drone(s, clock, model);
-  auto camera = detail::open_scenario_camera(s.camera, clock);
+  detail::CameraOptions camera_options;
+  camera_options.fixture_cache_dir = options.fixture_cache_dir;
+  camera_options.full_model = options.model != "lite";
+  camera_options.model_dir = options.model_dir;
+  auto camera = detail::open_scenario_camera(s.camera, camera_options);
   result.camera = camera->describe();
 
   gesture::GestureEngine engine(clock, std::make_unique<gesture::RuleBasedRecognizer>());

@@ -7,6 +7,15 @@
 #include <opencv2/imgproc.hpp>
 
 namespace gbdcs::vision {
+
+std::optional<contracts::Landmarks> strongest_hand(const std::vector<contracts::Landmarks>& hands) {
+  const contracts::Landmarks* best = nullptr;
+  for (const auto& h : hands) {
+    if (best == nullptr || h.score > best->score) best = &h;
+  }
+  if (best == nullptr) return std::nullopt;
+  return *best;
+}
 namespace {
 
 using contracts::Duration;
@@ -282,12 +291,7 @@ void VisionPipeline::classify_loop() {
     r.height = item->height;
     classifier_.set_frame_size(r.width, r.height);
     r.hands = classifier_.classify(item->hands);
-    const contracts::Landmarks* strongest = nullptr;
-    for (const auto& hand : item->hands) {
-      if (strongest == nullptr || hand.score > strongest->score) strongest = &hand;
-    }
-    r.gesture_event = engine_.process(
-        strongest ? std::optional<contracts::Landmarks>(*strongest) : std::nullopt, r.frame_id);
+    r.gesture_event = engine_.process(strongest_hand(item->hands), r.frame_id);
     const auto t1 = clock_.now();
     r.latency = t1 - r.capture_time;
     {

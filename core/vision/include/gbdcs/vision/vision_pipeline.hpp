@@ -62,6 +62,10 @@ class HandFinder {
   virtual void reset() {}  // forget tracking state
 };
 
+// The hand the gesture engine follows: the highest presence, the first on a tie (the
+// pipeline's classify stage and the scenario runner's pixel cameras).
+std::optional<contracts::Landmarks> strongest_hand(const std::vector<contracts::Landmarks>& hands);
+
 struct TrackerOptions;  // gbdcs/vision/hand_tracker.hpp
 // The real finder: a HandTracker (loads the models; throws what HandTracker throws).
 std::unique_ptr<HandFinder> make_tracker_finder(const TrackerOptions& options,

@@ -50,7 +50,7 @@ struct CameraSpec {
   nlohmann::json timeline;  // kTimeline: the timeline document (inline or read from the file)
   std::string path;         // kRecipe: the recipe file; kRecorded: the video file
   std::string labels_path;  // kRecorded: the labels.json of the video
-  double fps = 30;          // kRecorded: frames per second of the video
+  double fps = 0;           // kRecorded: frames per second of the video (0: labels.json's)
 };
 
 enum class EventType {

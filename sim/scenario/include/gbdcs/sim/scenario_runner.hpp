@@ -44,6 +44,11 @@ struct RunOptions {
   nlohmann::json failsafe_override;  // merged over the scenario's failsafe (tests of the suite)
   double video_fps = 10;
   bool keep_record = false;  // copy the RunRecord into the result (tests)
+  // Pixel cameras (recipe, video): where recipes are rendered once and kept (the cache
+  // `gbdcs eval --cache` uses; empty: <temp>/gbdcs-fixture-cache) and the hand models.
+  std::string fixture_cache_dir;
+  std::string model = "full";  // full | lite
+  std::string model_dir;       // empty: $GBDCS_MODEL_DIR or the build tree's models/
 };
 
 struct ScenarioResult {
