@@ -41,7 +41,7 @@ using Steady = std::chrono::steady_clock;
 struct SoakOptions {
   std::string duration = "30m";
   int clients = 20;
-  std::string source = "recipe:fixtures/recipes/demo_flight.json?live=1";
+  std::string source = "recipe:fixtures/recipes/demo_flight.json?live=1&fps=30";
   std::string adapter = "twin";
   double kill_worker_every_s = 300;
   double warmup_s = 30;

@@ -10,6 +10,7 @@
 #include <sstream>
 #include <thread>
 
+#include "gbdcs/contracts/json_file.hpp"
 #include "gbdcs/sim/fixture_cache.hpp"
 #include "gbdcs/sim/fixture_renderer.hpp"
 #include "gbdcs/sim/hand_scene.hpp"
@@ -30,6 +31,35 @@ std::filesystem::path cached_fixture(const std::filesystem::path& recipe_path,
   return sim::cached_fixture(recipe_path, cache_dir, progress);
 }
 
+namespace {
+
+// The recipe with its "fps" replaced, as <cache>/recipes/<stem>@<fps>fps.json (rewritten only
+// when it differs), so it gets a cache entry of its own.
+fs::path recipe_at_fps(const fs::path& recipe_path, double fps, const fs::path& cache_dir) {
+  auto doc = contracts::read_json_file<vision::CaptureError>(recipe_path.string(), "recipe");
+  if (!doc.is_object()) throw vision::CaptureError(recipe_path.string() + ": not a recipe object");
+  doc["fps"] = fps;
+  doc.erase("$schema");
+  char name[64];
+  std::snprintf(name, sizeof name, "@%gfps.json", fps);
+  const fs::path out = cache_dir / "recipes" / (recipe_path.stem().string() + name);
+  const std::string text = doc.dump(1) + "\n";
+  std::ifstream old(out, std::ios::binary);
+  std::stringstream current;
+  current << old.rdbuf();
+  if (current.str() != text) {
+    std::error_code ec;
+    fs::create_directories(out.parent_path(), ec);
+    const fs::path tmp = out.string() + ".partial-" + std::to_string(::getpid());
+    std::ofstream(tmp, std::ios::binary) << text;
+    fs::rename(tmp, out, ec);
+    if (ec) throw std::runtime_error(out.string() + ": cannot write: " + ec.message());
+  }
+  return out;
+}
+
+}  // namespace
+
 fs::path fixture_cache_dir() {
   if (const char* env = std::getenv("GBDCS_FIXTURE_CACHE"); env && *env) return env;
   std::error_code ec;
@@ -43,6 +73,7 @@ std::unique_ptr<vision::CaptureSource> open_recipe_source(std::string_view spec,
   std::string rest(spec.substr(7));  // after "recipe:"
   bool live = false;
   bool cache = true;
+  double fps = 0;  // 0: the recipe's own
   if (const auto q = rest.find('?'); q != std::string::npos) {
     std::stringstream query(rest.substr(q + 1));
     rest = rest.substr(0, q);
@@ -51,17 +82,33 @@ std::unique_ptr<vision::CaptureSource> open_recipe_source(std::string_view spec,
         live = true;
       } else if (option == "cache=0" || option == "cache=false") {
         cache = false;
+      } else if (option.rfind("fps=", 0) == 0) {
+        try {
+          std::size_t used = 0;
+          fps = std::stod(option.substr(4), &used);
+          if (used != option.size() - 4) fps = -1;
+        } catch (const std::exception&) {
+          fps = -1;
+        }
+        if (!(fps >= 1 && fps <= 120)) {
+          throw vision::CaptureError(std::string(spec) +
+                                     ": fps must be a number from 1 to 120, as in fps=30");
+        }
       } else if (option != "live=0" && option != "live=false" && option != "cache=1" &&
                  option != "cache=true") {
         throw vision::CaptureError(std::string(spec) + ": unknown option \"" + option +
-                                   "\"; the options are live=1 and cache=0");
+                                   "\"; the options are live=1, fps=N and cache=0");
       }
     }
   }
+  if (fps > 0 && !(live && cache)) {
+    throw vision::CaptureError(std::string(spec) + ": fps=N needs live=1 (and the cache)");
+  }
   if (live && cache) {
-    const fs::path recipe_path = sim::resolve_fixture_path(rest);
+    fs::path recipe_path = sim::resolve_fixture_path(rest);
     fs::path dir;
     try {
+      if (fps > 0) recipe_path = recipe_at_fps(recipe_path, fps, fixture_cache_dir());
       dir = cached_fixture(recipe_path, fixture_cache_dir(), preparing);
     } catch (const sim::RecipeError& e) {
       throw vision::CaptureError(e.what());

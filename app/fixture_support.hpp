@@ -30,11 +30,13 @@ std::filesystem::path cached_fixture(const std::filesystem::path& recipe_path,
                                      const std::filesystem::path& cache_dir,
                                      const Progress& progress = {});
 
-// recipe:PATH[?live=1[&cache=0]] as a capture source.
+// recipe:PATH[?live=1[&fps=N][&cache=0]] as a capture source.
 //   live=1    a camera: the recipe's video, rendered once into the fixture cache
 //             (fixture_cache_dir(); `preparing` is told the progress while it renders) and
 //             played back in a loop at the recipe's frame rate with real timing
 //             (vision::open_live_video), so the camera keeps its rate on a busy CPU.
+//   fps=N     with live=1: the recipe rendered at N frames a second instead of its own rate
+//             (its own cache entry; the motion is defined in seconds, so the same video).
 //   cache=0   with live=1: render every frame on the capture thread instead (no cache; the
 //             rate is whatever the CPU renders, ~17 FPS at 640x480 on two idle cores).
 //   neither   the frames rendered as fast as they are read; the stream ends with the recipe.

@@ -32,7 +32,7 @@ struct ServeOptions {
   std::string db = "var/gbdcs.db";
   std::string adapter;  // empty: the stored choice, else twin
   std::string adapter_options = "{}";
-  std::string source = "recipe:fixtures/recipes/demo_flight.json?live=1";
+  std::string source = "recipe:fixtures/recipes/demo_flight.json?live=1&fps=30";
   std::string config;
   std::string web = "web/dist";
   bool log_json = false;
