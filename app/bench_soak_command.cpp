@@ -6,7 +6,9 @@
 // must hover, raise VISION_WORKER_LOST and restart it: alerts to deliver, under load.
 //
 // Measured over the window (after --warmup):
-//   rss_mb_start/max/end/growth of the server process (VmRSS sampled every --sample-every s),
+//   rss_mb_start/max/end/growth of the server process (VmRSS sampled every --sample-every s;
+//   start and end are the lowest sample of the window's first and last quarter, so growth
+//   is the rise of the floor, not a transient peak caught at one end),
 //   worker_rss_mb_max; alerts_sent (the server's own `alert` log lines in the window),
 //   alerts_received / alerts_expected (sent x clients) / alerts_dropped; delivery_ms_p50/p99
 //   (telemetry: envelope stamp -> client), frame_age_ms_p99 (capture -> client),
@@ -24,6 +26,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <sstream>
 
 #include "command_registry.hpp"
@@ -156,8 +159,11 @@ int run_soak(const SoakOptions& o) {
   const auto window_start = Steady::now();
   const std::int64_t t0_ms = soak::now_utc_ms();
   const auto load_start = load_average();
-  const double rss_start = soak::rss_mb(serve.pid());
-  double rss_max = rss_start, rss_end = rss_start, worker_rss_max = 0;
+  // (seconds into the window, server VmRSS MB): growth compares the floors of the first and
+  // the last quarter, so a transient peak (a login's password hash takes tens of MB for a
+  // moment) sampled at either end is not counted as growth; a leak raises the floor.
+  std::vector<std::pair<double, double>> rss_samples = {{0.0, soak::rss_mb(serve.pid())}};
+  double rss_max = rss_samples.front().second, worker_rss_max = 0;
   double load_sum = 0;
   int load_samples = 0;
   std::vector<double> rest_ms;
@@ -176,7 +182,7 @@ int run_soak(const SoakOptions& o) {
     next_sample += std::chrono::duration_cast<Steady::duration>(std::chrono::duration<double>(o.sample_every_s));
     const double rss = soak::rss_mb(serve.pid());
     rss_max = std::max(rss_max, rss);
-    rss_end = rss;
+    rss_samples.emplace_back(std::chrono::duration<double>(Steady::now() - window_start).count(), rss);
     for (auto w : soak::children_of(serve.pid())) worker_rss_max = std::max(worker_rss_max, soak::rss_mb(w));
     load_sum += load_average()[0];
     ++load_samples;
@@ -255,6 +261,15 @@ int run_soak(const SoakOptions& o) {
     quick_check_ok = false;
     quick_check_error = e.what();
   }
+  const auto floor_between = [&](double from_s, double to_s) {
+    double lowest = std::numeric_limits<double>::infinity();
+    for (const auto& [at_s, mb] : rss_samples) {
+      if (at_s >= from_s && at_s <= to_s) lowest = std::min(lowest, mb);
+    }
+    return lowest;
+  };
+  const double rss_start = floor_between(0, window_s / 4);
+  const double rss_end = std::min(floor_between(window_s * 3 / 4, window_s), rss_samples.back().second);
   const double growth = rss_end - rss_start;
   const bool pass = server_alive && exit_status == 0 && dropped == 0 &&
                     (o.kill_worker_every_s <= 0 || !sent.empty()) &&
