@@ -15,6 +15,7 @@
 #include "gbdcs/sim/fixture_renderer.hpp"
 #include "gbdcs/sim/hand_scene.hpp"
 #include "gbdcs/sim/recipe.hpp"
+#include "gbdcs/vision/source_option.hpp"
 
 namespace gbdcs::app {
 
@@ -83,13 +84,7 @@ std::unique_ptr<vision::CaptureSource> open_recipe_source(std::string_view spec,
       } else if (option == "cache=0" || option == "cache=false") {
         cache = false;
       } else if (option.rfind("fps=", 0) == 0) {
-        try {
-          std::size_t used = 0;
-          fps = std::stod(option.substr(4), &used);
-          if (used != option.size() - 4) fps = -1;
-        } catch (const std::exception&) {
-          fps = -1;
-        }
+        fps = vision::number_option(option, "fps").value_or(-1);
         if (!(fps >= 1 && fps <= 120)) {
           throw vision::CaptureError(std::string(spec) +
                                      ": fps must be a number from 1 to 120, as in fps=30");

@@ -1,5 +1,6 @@
 // Capture sources: OpenCV camera and video file, a sorted folder of images, a generator.
 #include "gbdcs/vision/capture.hpp"
+#include "gbdcs/vision/source_option.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -11,6 +12,22 @@
 #include <opencv2/videoio/registry.hpp>
 
 namespace gbdcs::vision {
+
+std::optional<double> number_option(std::string_view option, std::string_view name) {
+  if (option.size() <= name.size() || option.substr(0, name.size()) != name ||
+      option[name.size()] != '=') {
+    return std::nullopt;
+  }
+  const std::string value(option.substr(name.size() + 1));
+  try {
+    std::size_t used = 0;
+    const double v = std::stod(value, &used);
+    if (used != value.size()) return std::nullopt;
+    return v;
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+}
 namespace fs = std::filesystem;
 
 namespace {
@@ -248,13 +265,7 @@ std::unique_ptr<CaptureSource> open_video_spec(const std::string& rest, const st
     if (option == "live=1" || option == "live=true") {
       live = true;
     } else if (option.rfind("fps=", 0) == 0) {
-      try {
-        std::size_t used = 0;
-        fps = std::stod(option.substr(4), &used);
-        if (used != option.size() - 4) fps = -1;
-      } catch (const std::exception&) {
-        fps = -1;
-      }
+      fps = number_option(option, "fps").value_or(-1);
       if (!(fps > 0 && fps <= 1000)) {
         throw CaptureError("source '" + spec + "': fps must be a number from 0 to 1000, as in fps=30");
       }
