@@ -108,6 +108,12 @@ int run_still(const StillOptions& o) {
                         {"truth_features", features(true_hand)},
                         {"truth_curl_ratio", curl_ratios(truth, o.width, o.height)},
                         {"found", !results.empty()}};
+  auto points = [](const std::array<contracts::Point3, contracts::kLandmarkCount>& ps) {
+    nlohmann::json a = nlohmann::json::array();
+    for (const auto& q : ps) a.push_back({q.x, q.y, q.z});
+    return a;
+  };
+  doc["truth_landmarks"] = points(truth);
   if (!results.empty()) {
     const auto& tracked = results.front().landmarks.points;
     std::array<double, contracts::kLandmarkCount> err{};
@@ -120,6 +126,7 @@ int run_still(const StillOptions& o) {
     }
     doc["gesture"] = contracts::to_string(results.front().gesture);
     doc["tracked_curl_ratio"] = curl_ratios(tracked, o.width, o.height);
+    doc["tracked_landmarks"] = points(tracked);
     doc["tracked_features"] = features(results.front().landmarks);
     doc["landmark_error_pct_mean"] = sum / static_cast<double>(err.size());
     doc["landmark_error_pct_by_point"] = err;
