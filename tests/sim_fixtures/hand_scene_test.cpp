@@ -3,6 +3,7 @@
 #include <cmath>
 #include <opencv2/core.hpp>
 #include <string>
+#include <vector>
 #include <random>
 
 #include "gbdcs/sim/hand_scene.hpp"
@@ -88,6 +89,46 @@ TEST(HandScene, LeftHandIsTheMirrorImageOfTheRightOne) {
   cv::flip(l.mask, flipped, 1);
   EXPECT_EQ(cv::countNonZero(r.mask != flipped), 0);
   EXPECT_GT(cv::countNonZero(r.mask), 500);
+}
+
+// The visible hand is one skinned surface: every vertex bound to the hand's bodies, the
+// primitives of the skin material hidden (kept for their mass), and the surface follows the
+// joints: in a fist and in an open hand every landmark the camera faces lies on drawn skin.
+TEST(HandScene, OneSkinCoversTheHandAndFollowsTheJoints) {
+  HandScene scene(320, 240);
+  const mjModel* m = scene.model();
+  ASSERT_EQ(m->nskin, 1);
+  EXPECT_GT(m->skin_vertnum[0], 2000);
+  EXPECT_GE(m->skin_texcoordadr[0], 0);
+  EXPECT_EQ(m->skin_matid[0], mj_name2id(m, mjOBJ_MATERIAL, "skin"));
+  std::vector<double> weight(static_cast<std::size_t>(m->skin_vertnum[0]), 0.0);
+  for (int b = m->skin_boneadr[0]; b < m->skin_boneadr[0] + m->skin_bonenum[0]; ++b) {
+    for (int k = 0; k < m->skin_bonevertnum[b]; ++k) {
+      const int i = m->skin_bonevertadr[b] + k;
+      weight[static_cast<std::size_t>(m->skin_bonevertid[i])] += m->skin_bonevertweight[i];
+    }
+  }
+  for (double w : weight) ASSERT_NEAR(w, 1.0, 1e-3);
+  const int skin = mj_name2id(m, mjOBJ_MATERIAL, "skin");
+  for (int g = 0; g < m->ngeom; ++g) {
+    if (m->geom_matid[g] == skin) {
+      EXPECT_EQ(m->geom_group[g], 3) << mj_id2name(m, mjOBJ_GEOM, g);
+    }
+  }
+  for (auto name : {PoseName::kFist, PoseName::kOpenPalm, PoseName::kPointUp}) {
+    std::mt19937 rng(3);
+    HandInstance hand;
+    hand.pose = pose_for(name, rng);
+    hand.distance_m = 0.45;
+    const auto r = scene.render(hand);
+    int on_skin = 0;
+    for (const auto& p : r.landmarks.points) {
+      const int x = static_cast<int>(p.x * 320), y = static_cast<int>(p.y * 240);
+      if (x >= 0 && x < 320 && y >= 0 && y < 240 && r.mask.at<unsigned char>(y, x) != 0) ++on_skin;
+    }
+    // A landmark is a joint centre or a pad end: inside the silhouette, or at its edge.
+    EXPECT_GE(on_skin, 19) << to_string(name);
+  }
 }
 
 }  // namespace
