@@ -17,6 +17,7 @@
 
 #include "command_registry.hpp"
 #include "commands.hpp"
+#include "eval_tally.hpp"
 #include "fixture_support.hpp"
 #include "gbdcs/contracts/codec.hpp"
 #include "gbdcs/sim/fixture_cache.hpp"
@@ -30,120 +31,6 @@ namespace {
 namespace fs = std::filesystem;
 using contracts::GestureType;
 using nlohmann::json;
-
-constexpr std::size_t kClasses = contracts::kAllGestures.size();
-
-std::size_t class_index(GestureType g) {
-  for (std::size_t i = 0; i < kClasses; ++i)
-    if (contracts::kAllGestures[i] == g) return i;
-  return 0;
-}
-
-struct Tally {
-  std::int64_t visible_frames = 0;   // hand fully visible (rendered) or expected (photos)
-  std::int64_t detected_frames = 0;  // ... where the tracker found it
-  std::int64_t deliberate_scored = 0;
-  std::int64_t deliberate_correct = 0;
-  std::int64_t non_deliberate_scored = 0;
-  std::int64_t false_positives = 0;
-  double landmark_error_sum_pct = 0;
-  std::int64_t landmark_error_count = 0;
-  double landmark_error_max_pct = 0;
-  std::array<double, contracts::kLandmarkCount> point_error_sum_pct{};
-  std::array<std::array<std::int64_t, kClasses>, kClasses> confusion{};  // [true][predicted]
-  // Scored frames per shown pose (rendered fixtures: FIST, RELAXED, ...; "NO_HAND"), by the
-  // gesture read: which poses the recogniser confuses, not only which gestures.
-  std::map<std::string, std::map<std::string, std::int64_t>> by_pose;
-
-  void add(const Tally& o) {
-    for (const auto& [pose, counts] : o.by_pose)
-      for (const auto& [g, n] : counts) by_pose[pose][g] += n;
-    visible_frames += o.visible_frames;
-    detected_frames += o.detected_frames;
-    deliberate_scored += o.deliberate_scored;
-    deliberate_correct += o.deliberate_correct;
-    non_deliberate_scored += o.non_deliberate_scored;
-    false_positives += o.false_positives;
-    landmark_error_sum_pct += o.landmark_error_sum_pct;
-    landmark_error_count += o.landmark_error_count;
-    landmark_error_max_pct = std::max(landmark_error_max_pct, o.landmark_error_max_pct);
-    for (std::size_t i = 0; i < contracts::kLandmarkCount; ++i)
-      point_error_sum_pct[i] += o.point_error_sum_pct[i];
-    for (std::size_t t = 0; t < kClasses; ++t)
-      for (std::size_t p = 0; p < kClasses; ++p) confusion[t][p] += o.confusion[t][p];
-  }
-  void score(GestureType truth, GestureType predicted, bool deliberate) {
-    confusion[class_index(truth)][class_index(predicted)]++;
-    if (deliberate) {
-      ++deliberate_scored;
-      if (predicted == truth) ++deliberate_correct;
-    } else {
-      ++non_deliberate_scored;
-      if (predicted != GestureType::kNone) ++false_positives;
-    }
-  }
-  std::int64_t scored() const { return deliberate_scored + non_deliberate_scored; }
-  std::int64_t correct() const {
-    std::int64_t c = 0;
-    for (std::size_t i = 0; i < kClasses; ++i) c += confusion[i][i];
-    return c;
-  }
-};
-
-std::optional<double> ratio(std::int64_t a, std::int64_t b) {
-  if (b == 0) return std::nullopt;
-  return static_cast<double>(a) / static_cast<double>(b);
-}
-
-json opt(const std::optional<double>& v) { return v ? json(*v) : json(nullptr); }
-
-json summary_json(const Tally& t) {
-  json per_class = json::object();
-  for (std::size_t c = 0; c < kClasses; ++c) {
-    std::int64_t tp = t.confusion[c][c], predicted = 0, actual = 0;
-    for (std::size_t o = 0; o < kClasses; ++o) {
-      predicted += t.confusion[o][c];
-      actual += t.confusion[c][o];
-    }
-    if (predicted == 0 && actual == 0) continue;
-    per_class[std::string(contracts::to_string(contracts::kAllGestures[c]))] = {
-        {"precision", opt(ratio(tp, predicted))},
-        {"recall", opt(ratio(tp, actual))},
-        {"support_frames", actual},
-        {"predicted_frames", predicted}};
-  }
-  json labels = json::array();
-  json matrix = json::array();
-  for (std::size_t c = 0; c < kClasses; ++c) {
-    labels.push_back(contracts::to_string(contracts::kAllGestures[c]));
-    matrix.push_back(t.confusion[c]);
-  }
-  json by_point = json::array();
-  for (double v : t.point_error_sum_pct)
-    by_point.push_back(t.landmark_error_count > 0
-                           ? json(v / static_cast<double>(t.landmark_error_count))
-                           : json(nullptr));
-  return {{"accuracy", opt(ratio(t.correct(), t.scored()))},
-          {"landmark_error_pct_by_point", by_point},
-          {"deliberate_accuracy", opt(ratio(t.deliberate_correct, t.deliberate_scored))},
-          {"false_positive_rate", opt(ratio(t.false_positives, t.non_deliberate_scored))},
-          {"detection_rate", opt(ratio(t.detected_frames, t.visible_frames))},
-          {"landmark_error_pct_mean",
-           t.landmark_error_count > 0
-               ? json(t.landmark_error_sum_pct / static_cast<double>(t.landmark_error_count))
-               : json(nullptr)},
-          {"landmark_error_pct_max",
-           t.landmark_error_count > 0 ? json(t.landmark_error_max_pct) : json(nullptr)},
-          {"frames_scored", t.scored()},
-          {"deliberate_frames", t.deliberate_scored},
-          {"non_deliberate_frames", t.non_deliberate_scored},
-          {"false_positive_frames", t.false_positives},
-          {"visible_frames", t.visible_frames},
-          {"detected_frames", t.detected_frames},
-          {"per_class", per_class},
-          {"by_pose", t.by_pose},
-          {"confusion", {{"labels", labels}, {"matrix", matrix}}}};
-}
 
 json read_json(const fs::path& path) {
   std::ifstream in(path);
@@ -366,57 +253,6 @@ Tally eval_manifest(const fs::path& csv, vision::HandFinder& finder,
                         {"hands", hands.size()}});
   }
   return t;
-}
-
-std::string fmt_pct(const json& v) {
-  if (v.is_null()) return "-";
-  std::ostringstream s;
-  s << std::fixed << std::setprecision(2) << 100 * v.get<double>() << " %";
-  return s.str();
-}
-
-void print_summary(const std::string& title, const json& s) {
-  std::cout << title << "\n"
-            << "  detection rate      " << fmt_pct(s["detection_rate"]) << " ("
-            << s["detected_frames"] << " of " << s["visible_frames"] << " fully visible)\n"
-            << "  landmark error      ";
-  if (s["landmark_error_pct_mean"].is_null()) {
-    std::cout << "- (no ground truth)\n";
-  } else {
-    std::cout << std::fixed << std::setprecision(2) << s["landmark_error_pct_mean"].get<double>()
-              << " % of hand size mean, " << s["landmark_error_pct_max"].get<double>()
-              << " % worst\n";
-  }
-  std::cout << "  accuracy            " << fmt_pct(s["accuracy"]) << " of " << s["frames_scored"]
-            << " frames\n"
-            << "  deliberate accuracy " << fmt_pct(s["deliberate_accuracy"]) << " of "
-            << s["deliberate_frames"] << "\n"
-            << "  false positives     " << fmt_pct(s["false_positive_rate"]) << " ("
-            << s["false_positive_frames"] << " of " << s["non_deliberate_frames"]
-            << " non-deliberate)\n";
-}
-
-void print_classes(const json& s) {
-  std::cout << "\n  " << std::left << std::setw(12) << "class" << std::right << std::setw(11)
-            << "precision" << std::setw(10) << "recall" << std::setw(9) << "frames\n";
-  for (const auto& [name, c] : s["per_class"].items()) {
-    std::cout << "  " << std::left << std::setw(12) << name << std::right << std::setw(11)
-              << fmt_pct(c["precision"]) << std::setw(10) << fmt_pct(c["recall"]) << std::setw(8)
-              << c["support_frames"] << "\n";
-  }
-  std::cout << "\n  confusion (rows: truth, columns: predicted)\n  " << std::setw(12) << "";
-  const auto& labels = s["confusion"]["labels"];
-  const auto& matrix = s["confusion"]["matrix"];
-  for (const auto& l : labels) std::cout << std::setw(6) << l.get<std::string>().substr(0, 5);
-  std::cout << "\n";
-  for (std::size_t r = 0; r < labels.size(); ++r) {
-    std::int64_t row_total = 0;
-    for (const auto& v : matrix[r]) row_total += v.get<std::int64_t>();
-    if (row_total == 0) continue;
-    std::cout << "  " << std::left << std::setw(12) << labels[r].get<std::string>() << std::right;
-    for (const auto& v : matrix[r]) std::cout << std::setw(6) << v.get<std::int64_t>();
-    std::cout << "\n";
-  }
 }
 
 int run_eval(const EvalOptions& o) {

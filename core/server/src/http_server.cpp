@@ -1,70 +1,17 @@
-// The transport: Beast listener, HTTP sessions, /ws/live and /worker WebSocket sessions.
-// Routing and auth decisions live in api_routes.cpp and live_hub.cpp.
+// The transport: the Beast listener and HTTP sessions; an upgrade request is checked here and
+// handed to the WebSocket sessions (ws_sessions.cpp). Routing and auth decisions live in
+// api_routes.cpp and live_hub.cpp.
 #include <openssl/crypto.h>
 
-#include <utility>  // before Asio: its awaitable.hpp needs std::exchange
-
-#include <boost/asio.hpp>
-#include <boost/beast.hpp>
-#include <boost/beast/websocket.hpp>
 #include <sstream>
-#include <thread>
 
-#include "api.hpp"
 #include "gbdcs/contracts/codec.hpp"
-#include "gbdcs/server/server.hpp"
+#include "server_impl.hpp"
 #include "static_files.hpp"
 
 namespace gbdcs::server {
 
-namespace beast = boost::beast;
-namespace http = beast::http;
-namespace websocket = beast::websocket;
-namespace net = boost::asio;
-using tcp = net::ip::tcp;
 using nlohmann::json;
-
-struct Server::Impl {
-  Impl(const contracts::Clock& c, storage::StorageManager& s, TokenService& t, DroneService& d,
-       LiveHub& h, ServerOptions o, EventLog l)
-      : clock(c), storage(s), tokens(t), drone(d), hub(h), options(std::move(o)), log(std::move(l)),
-        limiter(c), replays(c, s, h, d), ids(c),
-        ctx{c, s, t, d, h, metrics, replays, limiter, options, log, c.now()}, acceptor(ioc) {}
-
-  const contracts::Clock& clock;
-  storage::StorageManager& storage;
-  TokenService& tokens;
-  DroneService& drone;
-  LiveHub& hub;
-  ServerOptions options;
-  EventLog log;
-  Metrics metrics;
-  LoginLimiter limiter;
-  ReplayManager replays;
-  UlidGenerator ids;
-  ApiContext ctx;
-  net::io_context ioc;
-  tcp::acceptor acceptor;
-  std::vector<std::thread> threads;
-  std::mutex worker_mutex;
-  WorkerHandlers worker;
-  bool stopped = false;
-
-  void accept();
-
-  // The transport-free half of an HTTP exchange, shared by the sockets (HttpSession) and
-  // Server::answer (the fuzz target): parser limits, the error for an unparsable request,
-  // and routing a parsed request to its response (logged, counted).
-  using Request = http::request<http::string_body>;
-  using Response = http::response<http::string_body>;
-  void limit(http::request_parser<http::string_body>& parser) const;
-  Response parse_failure(beast::error_code ec, const std::string& remote);
-  Response respond(const Request& req, const std::string& remote);
-  ApiResponse dispatch(const Request& req, const std::string& remote, const std::string& rid,
-                       std::string& path);
-  void log_request(const std::string& rid, const std::string& method, const std::string& path,
-                   const std::string& remote, const ApiResponse& a, double ms);
-};
 
 namespace {
 
@@ -100,213 +47,6 @@ std::map<std::string, std::string> parse_query(std::string_view q) {
 }
 
 bool is_loopback(const tcp::endpoint& e) { return e.address().is_loopback(); }
-
-// ---- /ws/live ---------------------------------------------------------------------------
-class LiveSession final : public LiveClient, public std::enable_shared_from_this<LiveSession> {
- public:
-  LiveSession(tcp::socket socket, Server::Impl& impl, TokenClaims claims)
-      : ws_(std::move(socket)), impl_(impl), claims_(std::move(claims)) {}
-
-  void start(Request req) {
-    ws_.set_option(websocket::stream_base::timeout::suggested(beast::role_type::server));
-    ws_.read_message_max(impl_.options.max_ws_message_bytes);
-    ws_.async_accept(req, [self = shared_from_this()](beast::error_code ec) {
-      if (ec) return;
-      self->impl_.hub.add(self);
-      self->deliver(self->impl_.hub.make("state", self->impl_.drone.state()));
-      self->read();
-    });
-  }
-
-  void deliver(const OutMessagePtr& m) override {
-    bool start_write = false, too_slow = false;
-    {
-      std::lock_guard lock(mutex_);
-      if (closed_) return;
-      too_slow = !queue_.push(m);
-      if (!writing_) start_write = writing_ = true;
-    }
-    if (too_slow) close_with(1008, "client too slow: alerts backed up");
-    if (start_write) net::post(ws_.get_executor(), [self = shared_from_this()] { self->write_next(); });
-  }
-
-  void close_with(int code, const std::string& reason) override {
-    net::post(ws_.get_executor(), [self = shared_from_this(), code, reason] {
-      if (self->closing_) return;
-      self->closing_ = true;
-      self->ws_.async_close(websocket::close_reason(static_cast<websocket::close_code>(code), reason),
-                            [self](beast::error_code) { self->finish(); });
-    });
-  }
-  const std::string& token_id() const override { return claims_.jti; }
-  contracts::UtcTime token_expires() const override { return claims_.expires_at; }
-  std::uint64_t dropped() const override {
-    std::lock_guard lock(mutex_);
-    return queue_.dropped();
-  }
-  std::size_t queued() const override {
-    std::lock_guard lock(mutex_);
-    return queue_.size();
-  }
-
- private:
-  void finish() {
-    {
-      std::lock_guard lock(mutex_);
-      closed_ = true;
-    }
-    impl_.hub.remove(this);
-  }
-
-  void write_next() {
-    {
-      std::lock_guard lock(mutex_);
-      auto next = queue_.pop();
-      if (!next || closed_) {
-        writing_ = false;
-        return;
-      }
-      current_ = *next;
-    }
-    ws_.text(true);
-    ws_.async_write(net::buffer(current_->text),
-                    [self = shared_from_this()](beast::error_code ec, std::size_t) {
-                      if (ec) {
-                        self->finish();
-                        std::lock_guard lock(self->mutex_);
-                        self->writing_ = false;
-                        return;
-                      }
-                      self->impl_.metrics.ws_delivery_ms.observe(
-                          contracts::to_seconds(self->impl_.clock.now() - self->current_->enqueued) *
-                          1000.0);
-                      self->write_next();
-                    });
-  }
-
-  void read() {
-    ws_.async_read(buffer_, [self = shared_from_this()](beast::error_code ec, std::size_t) {
-      if (ec) {
-        self->finish();
-        return;
-      }
-      std::string text = beast::buffers_to_string(self->buffer_.data());
-      self->buffer_.consume(self->buffer_.size());
-      self->on_message(text);
-      self->read();
-    });
-  }
-
-  void reply_error(const std::string& code, const std::string& cause, const std::string& suggestion) {
-    deliver(impl_.hub.make("error", {{"error", code}, {"cause", cause},
-                                     {"suggestion", suggestion}, {"request_id", impl_.ids.next()}}));
-  }
-
-  void on_message(const std::string& text) {
-    json doc;
-    try {
-      doc = contracts::parse_json(text);
-    } catch (const std::exception& e) {
-      return reply_error("malformed_json", e.what(), "send one JSON object per message");
-    }
-    const std::string type = doc.is_object() && doc.contains("type") && doc["type"].is_string()
-                                 ? doc["type"].get<std::string>() : "";
-    std::string schema;
-    if (type == "ack") schema = "ws_ack";
-    else if (type == "input") schema = "ws_input";
-    else if (type == "emergency_stop") schema = "ws_emergency_stop";
-    else return reply_error("invalid_message", "unknown message type '" + type.substr(0, 40) + "'",
-                            "send type ack, input or emergency_stop (docs/API.md)");
-    try {
-      contracts::validate(schema, doc);
-    } catch (const contracts::ContractError& e) {
-      return reply_error("invalid_message", e.what(),
-                         "see core/contracts/schemas/" + schema + ".schema.json");
-    }
-    if (type == "emergency_stop") {
-      impl_.drone.emergency_stop(contracts::CommandSource::kApi,
-                                 "ws:user:" + std::to_string(claims_.user_id));
-    } else if (type == "input") {
-      impl_.drone.key(doc["key"].get<std::string>(), doc["pressed"].get<bool>());
-    } else {
-      const auto id = doc["alert_id"].get<std::int64_t>();
-      if (!impl_.storage.acknowledge_alert_by(id, claims_.user_id)) {
-        return reply_error("not_found", "there is no alert " + std::to_string(id),
-                           "acknowledge the data.id of an alert message");
-      }
-      auto a = impl_.storage.find_alert(id);
-      if (impl_.log) impl_.log("info", {{"event", "alert_ack"}, {"alert_id", id},
-                                        {"user_id", claims_.user_id}});
-      deliver(impl_.hub.make(
-          "ack_result", {{"alert_id", id},
-                         {"acknowledged_at", contracts::format_utc(a && a->acknowledged_at
-                                                                        ? *a->acknowledged_at
-                                                                        : impl_.clock.utc_now())}}));
-    }
-  }
-
-  websocket::stream<beast::tcp_stream> ws_;
-  Server::Impl& impl_;
-  TokenClaims claims_;
-  beast::flat_buffer buffer_;
-  mutable std::mutex mutex_;
-  ClientQueue queue_;
-  bool writing_ = false;
-  bool closed_ = false;
-  bool closing_ = false;
-  OutMessagePtr current_;
-};
-
-// ---- /worker ----------------------------------------------------------------------------
-class WorkerSession final : public std::enable_shared_from_this<WorkerSession> {
- public:
-  WorkerSession(tcp::socket socket, Server::Impl& impl) : ws_(std::move(socket)), impl_(impl) {}
-  void start(Request req) {
-    ws_.read_message_max(8 << 20);  // frames carry a JPEG
-    ws_.async_accept(req, [self = shared_from_this()](beast::error_code ec) {
-      if (ec) return;
-      WorkerHandlers h;
-      {
-        std::lock_guard lock(self->impl_.worker_mutex);
-        h = self->impl_.worker;
-      }
-      if (h.connected) h.connected();
-      self->read();
-    });
-  }
-
- private:
-  void read() {
-    ws_.async_read(buffer_, [self = shared_from_this()](beast::error_code ec, std::size_t) {
-      WorkerHandlers h;
-      {
-        std::lock_guard lock(self->impl_.worker_mutex);
-        h = self->impl_.worker;
-      }
-      if (ec) {
-        if (h.closed) h.closed();
-        return;
-      }
-      const auto text = beast::buffers_to_string(self->buffer_.data());
-      self->buffer_.consume(self->buffer_.size());
-      try {
-        auto doc = contracts::parse_json(text);
-        const auto type = doc.value("type", "");
-        contracts::validate(type == "heartbeat"  ? "vision_heartbeat"
-                            : type == "picture" ? "vision_picture"
-                                                : "vision_frame",
-                            doc);
-        if (h.message) h.message(doc);
-      } catch (const std::exception& e) {
-        if (self->impl_.log) self->impl_.log("warn", {{"event", "worker_bad_message"}, {"cause", e.what()}});
-      }
-      self->read();
-    });
-  }
-  websocket::stream<beast::tcp_stream> ws_;
-  Server::Impl& impl_;
-  beast::flat_buffer buffer_;
-};
 
 // ---- HTTP -------------------------------------------------------------------------------
 class HttpSession final : public std::enable_shared_from_this<HttpSession> {
@@ -407,7 +147,7 @@ class HttpSession final : public std::enable_shared_from_this<HttpSession> {
         return refuse(e, req);
       }
       stream_.expires_never();
-      std::make_shared<LiveSession>(stream_.release_socket(), impl_, claims)->start(std::move(req));
+      start_live_session(stream_.release_socket(), impl_, claims, std::move(req));
       return;
     }
     if (path == "/worker") {
@@ -424,7 +164,7 @@ class HttpSession final : public std::enable_shared_from_this<HttpSession> {
                       req);
       }
       stream_.expires_never();
-      std::make_shared<WorkerSession>(stream_.release_socket(), impl_)->start(std::move(req));
+      start_worker_session(stream_.release_socket(), impl_, std::move(req));
       return;
     }
     refuse(ApiError(404, "not_found", "no WebSocket at " + path.substr(0, 200), "use /ws/live?token=..."), req);
