@@ -10,6 +10,7 @@
 #include <iomanip>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <opencv2/core/utils/logger.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -20,6 +21,7 @@
 #include "eval_tally.hpp"
 #include "fixture_support.hpp"
 #include "gbdcs/contracts/codec.hpp"
+#include "gbdcs/gesture/hand_features.hpp"
 #include "gbdcs/sim/fixture_cache.hpp"
 #include "gbdcs/vision/model_files.hpp"
 #include "gbdcs/vision/vision_pipeline.hpp"
@@ -58,6 +60,7 @@ struct EvalOptions {
   bool json = false;
   bool check = false;
   bool per_fixture = false;
+  std::string frames_out;
   double min_detection = 0.98;
   double max_landmark_error_pct = 3.0;
   double min_accuracy = 0.97;
@@ -65,9 +68,47 @@ struct EvalOptions {
   ModelChoice models;
 };
 
-// One fixture folder: video.mp4 + labels.json.
+// One scored frame for --frames: what was shown, what was read, and the recogniser's
+// features on the tracked and on the true landmarks.
+json frame_record(const fs::path& dir, const json& label, std::size_t frame, GestureType expected,
+                  GestureType predicted, const vision::HandResult* match, double error_pct,
+                  const std::optional<contracts::Landmarks>& truth, GestureType truth_read,
+                  double aspect) {
+  auto features = [aspect](const contracts::Landmarks& h) {
+    const auto f = gesture::extract_features(h, aspect, 1.0);
+    const auto flat = gesture::extract_features(h, aspect, 0.0);
+    return json{{"finger_curl_deg", f.finger_curl_deg},
+                {"finger_curl_deg_image_plane", flat.finger_curl_deg},
+                {"thumb_bend_deg", f.thumb_bend_deg},
+                {"thumb_lateral", f.thumb_lateral},
+                {"thumb_direction_deg", f.thumb_direction_deg},
+                {"thumb_in_plane", f.thumb_in_plane},
+                {"index_direction_deg", f.index_direction_deg},
+                {"index_in_plane", f.index_in_plane},
+                {"index_middle_spread_deg", f.index_middle_spread_deg}};
+  };
+  json r = {{"fixture", dir.filename().string()},
+            {"frame", frame},
+            {"pose", label.value("hand_present", false) ? label.value("pose", "?") : "NO_HAND"},
+            {"expected", contracts::to_string(expected)},
+            {"predicted", contracts::to_string(predicted)},
+            {"found", match != nullptr}};
+  if (match != nullptr) {
+    r["tracked_features"] = features(match->landmarks);
+    if (truth) r["landmark_error_pct"] = error_pct;
+  }
+  if (truth) {
+    r["truth_read"] = contracts::to_string(truth_read);
+    r["truth_features"] = features(*truth);
+  }
+  return r;
+}
+
+// One fixture folder: video.mp4 + labels.json. `frames_out`, when open, gets one JSON line per
+// scored frame.
 Tally eval_fixture(const fs::path& dir, vision::HandFinder& finder,
-                   vision::HandClassifier& classifier, const contracts::Clock& clock) {
+                   vision::HandClassifier& classifier, const contracts::Clock& clock,
+                   std::ostream* frames_out) {
   const json labels = read_json(dir / "labels.json");
   if (!labels.contains("frames") || !labels["frames"].is_array())
     throw std::runtime_error((dir / "labels.json").string() +
@@ -141,7 +182,29 @@ Tally eval_fixture(const fs::path& dir, vision::HandFinder& finder,
       for (const auto& h : hands)
         if (h.gesture != GestureType::kNone) predicted = h.gesture;
     }
-    t.score(deliberate ? truth : GestureType::kNone, predicted, deliberate);
+    const GestureType expected = deliberate ? truth : GestureType::kNone;
+    t.score(expected, predicted, deliberate);
+    std::optional<contracts::Landmarks> true_hand;
+    GestureType truth_read = GestureType::kNone;
+    if (gt.is_array() && gt.size() == contracts::kLandmarkCount) {
+      true_hand.emplace();
+      for (std::size_t k = 0; k < contracts::kLandmarkCount; ++k) {
+        const json& q = gt[k];
+        true_hand->points[k] = {q[0].get<double>(), q[1].get<double>(),
+                                q.size() > 2 ? q[2].get<double>() : 0.0};
+      }
+      true_hand->score = 1;
+      truth_read = classifier.recognize(*true_hand).gesture;
+      t.score_truth(expected, truth_read, deliberate);
+    }
+    if (frames_out != nullptr) {
+      const double size = std::max(1.0, l.value("hand_size_px", 0.0));
+      *frames_out << frame_record(dir, l, i - 1, expected, predicted, match,
+                                  100.0 * match_px / size, true_hand, truth_read,
+                                  static_cast<double>(rgb.cols) / rgb.rows)
+                         .dump()
+                  << "\n";
+    }
     const std::string pose = l.value("hand_present", false) ? l.value("pose", "?") : "NO_HAND";
     ++t.by_pose[pose][std::string(contracts::to_string(predicted))];
   }
@@ -297,10 +360,17 @@ int run_eval(const EvalOptions& o) {
       fixtures.push_back(cached_fixture(r, cache, terminal_progress("render " + r.stem().string())));
     }
   }
+  std::ofstream frames_file;
+  if (!o.frames_out.empty()) {
+    frames_file.open(o.frames_out, std::ios::trunc);
+    if (!frames_file)
+      throw std::runtime_error(o.frames_out + ": cannot write the --frames file (check the folder)");
+  }
   if (!fixtures.empty()) {
     auto finder = vision::make_tracker_finder(tracker_options(o.models, false), clock);
     for (const auto& dir : fixtures) {
-      const Tally t = eval_fixture(dir, *finder, classifier, clock);
+      const Tally t =
+          eval_fixture(dir, *finder, classifier, clock, frames_file.is_open() ? &frames_file : nullptr);
       total.add(t);
       json s = summary_json(t);
       s["fixture"] = dir.string();
@@ -376,6 +446,10 @@ void add_eval_command(CLI::App& app) {
                    "$TMPDIR/gbdcs-fixture-cache)");
   eval->add_flag("--json", o.json, "One JSON object");
   eval->add_flag("--per-fixture", o.per_fixture, "Also print each fixture's figures");
+  eval->add_option("--frames", o.frames_out,
+                   "Write one JSON line per scored fixture frame to this file: pose, expected and "
+                   "predicted gesture, the recogniser's features on the tracked and on the true "
+                   "landmarks, landmark error (to find why a pose is misread)");
   eval->add_flag("--check", o.check,
                  "Exit 1 unless the targets are met (docs/ACCURACY.md): detection, landmark "
                  "error, deliberate accuracy, false positives");

@@ -57,6 +57,10 @@ json summary_json(const Tally& t) {
           {"deliberate_accuracy", opt(ratio(t.deliberate_correct, t.deliberate_scored))},
           {"false_positive_rate", opt(ratio(t.false_positives, t.non_deliberate_scored))},
           {"detection_rate", opt(ratio(t.detected_frames, t.visible_frames))},
+          {"truth_deliberate_accuracy",
+           opt(ratio(t.truth_deliberate_correct, t.truth_deliberate_scored))},
+          {"truth_false_positive_rate",
+           opt(ratio(t.truth_false_positives, t.truth_non_deliberate_scored))},
           {"landmark_error_pct_mean",
            t.landmark_error_count > 0
                ? json(t.landmark_error_sum_pct / static_cast<double>(t.landmark_error_count))
@@ -104,6 +108,11 @@ void print_summary(const std::string& title, const json& s) {
             << "  false positives     " << fmt_pct(s["false_positive_rate"]) << " ("
             << s["false_positive_frames"] << " of " << s["non_deliberate_frames"]
             << " non-deliberate)\n";
+  if (!s["truth_deliberate_accuracy"].is_null() || !s["truth_false_positive_rate"].is_null()) {
+    std::cout << "  on true landmarks   " << fmt_pct(s["truth_deliberate_accuracy"])
+              << " deliberate accuracy, " << fmt_pct(s["truth_false_positive_rate"])
+              << " false positives (the recogniser alone)\n";
+  }
 }
 
 void print_classes(const json& s) {

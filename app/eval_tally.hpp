@@ -23,6 +23,12 @@ struct Tally {
   std::int64_t deliberate_correct = 0;
   std::int64_t non_deliberate_scored = 0;
   std::int64_t false_positives = 0;
+  // The recogniser on the true landmarks of the same scored frames (rendered fixtures): what
+  // the tracker could reach at best; below 1 means the pose or its label is at fault.
+  std::int64_t truth_deliberate_scored = 0;
+  std::int64_t truth_deliberate_correct = 0;
+  std::int64_t truth_non_deliberate_scored = 0;
+  std::int64_t truth_false_positives = 0;
   double landmark_error_sum_pct = 0;
   std::int64_t landmark_error_count = 0;
   double landmark_error_max_pct = 0;
@@ -41,6 +47,10 @@ struct Tally {
     deliberate_correct += o.deliberate_correct;
     non_deliberate_scored += o.non_deliberate_scored;
     false_positives += o.false_positives;
+    truth_deliberate_scored += o.truth_deliberate_scored;
+    truth_deliberate_correct += o.truth_deliberate_correct;
+    truth_non_deliberate_scored += o.truth_non_deliberate_scored;
+    truth_false_positives += o.truth_false_positives;
     landmark_error_sum_pct += o.landmark_error_sum_pct;
     landmark_error_count += o.landmark_error_count;
     landmark_error_max_pct = std::max(landmark_error_max_pct, o.landmark_error_max_pct);
@@ -57,6 +67,15 @@ struct Tally {
     } else {
       ++non_deliberate_scored;
       if (predicted != contracts::GestureType::kNone) ++false_positives;
+    }
+  }
+  void score_truth(contracts::GestureType truth, contracts::GestureType read, bool deliberate) {
+    if (deliberate) {
+      ++truth_deliberate_scored;
+      if (read == truth) ++truth_deliberate_correct;
+    } else {
+      ++truth_non_deliberate_scored;
+      if (read != contracts::GestureType::kNone) ++truth_false_positives;
     }
   }
   std::int64_t scored() const { return deliberate_scored + non_deliberate_scored; }
