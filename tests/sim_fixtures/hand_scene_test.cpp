@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 #include <string>
 #include <vector>
 #include <random>
@@ -129,6 +130,32 @@ TEST(HandScene, OneSkinCoversTheHandAndFollowsTheJoints) {
     // A landmark is a joint centre or a pad end: inside the silhouette, or at its edge.
     EXPECT_GE(on_skin, 19) << to_string(name);
   }
+}
+
+
+// Edges are anti-aliased: the hand is drawn at kSupersample times the size and averaged down,
+// so its outline has pixels the hand covers only partly (the mask holds the coverage), and
+// their colour is the hand's own, not darkened by the black the hand was drawn on.
+TEST(HandScene, EdgesAreAntiAliasedWithTheHandsOwnColour) {
+  HandScene scene(320, 240);
+  std::mt19937 rng(5);
+  HandInstance h;
+  h.pose = pose_for(PoseName::kOpenPalm, rng);
+  h.distance_m = 0.5;
+  const auto r = scene.render(h);
+  cv::Mat inside = r.mask == 255;
+  cv::Mat edge = (r.mask > 0) & (r.mask < 255);
+  const int edge_pixels = cv::countNonZero(edge);
+  // The outline of an open hand at this size is several hundred pixels long.
+  EXPECT_GT(edge_pixels, 200);
+  EXPECT_GT(cv::countNonZero(inside), 10 * edge_pixels);
+  cv::Mat grey;
+  cv::cvtColor(r.bgr, grey, cv::COLOR_BGR2GRAY);
+  const double inside_level = cv::mean(grey, inside)[0];
+  const double edge_level = cv::mean(grey, edge)[0];
+  // The outline turns away from the light, so it is darker than the inside anyway (about 0.7
+  // of it); premultiplied by its coverage (about half) it would be about 0.35.
+  EXPECT_GT(edge_level, 0.5 * inside_level) << "edge " << edge_level << ", inside " << inside_level;
 }
 
 }  // namespace
