@@ -39,7 +39,10 @@ struct FingerSpec {
   double mcp, pip, dip, sigma;
 };
 constexpr FingerSpec kExtended{3, 5, 5, 3.5};
-constexpr FingerSpec kFolded{85, 100, 60, 5};     // tight fist
+constexpr FingerSpec kFolded{85, 100, 60, 5};     // folded under a thumb (THUMB_UP, CALL, ...)
+// A clenched fist: the composite flexion of a normal full fist, about 260 deg (MCP 90, PIP
+// 100, DIP 70); the folded fingers of the thumb poses are a little looser (245 deg).
+constexpr FingerSpec kClenched{90, 100, 70, 5};
 constexpr FingerSpec kHeld{80, 98, 55, 5};        // folded, held down by the thumb
 // The resting hand (RELAXED): flexion grows from the index to the little finger, the
 // "cascade" of a hand at rest (MCP 30-45, PIP 40-55, DIP 15-22).
@@ -205,7 +208,7 @@ HandPose pose_for(PoseName name, std::mt19937& rng) {
       face_camera(pose, 0.2, rng);
       break;
     case PoseName::kFist:
-      pose = make(kThumbOverFingers, {fold, fold, fold, fold}, 3, rng);
+      pose = make(kThumbOverFingers, {&kClenched, &kClenched, &kClenched, &kClenched}, 3, rng);
       face_camera(pose, 0.5, rng);
       break;
     case PoseName::kThumbUp:
