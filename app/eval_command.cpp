@@ -195,7 +195,7 @@ Tally eval_fixture(const fs::path& dir, vision::HandFinder& finder,
       }
       true_hand->score = 1;
       truth_read = classifier.recognize(*true_hand).gesture;
-      t.score_truth(expected, truth_read, deliberate);
+      t.truth_reads.score(expected, truth_read, deliberate);
     }
     if (frames_out != nullptr) {
       const double size = std::max(1.0, l.value("hand_size_px", 0.0));

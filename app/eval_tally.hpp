@@ -16,19 +16,38 @@ constexpr std::size_t kClasses = contracts::kAllGestures.size();
 
 std::size_t class_index(contracts::GestureType g);
 
-struct Tally {
-  std::int64_t visible_frames = 0;   // hand fully visible (rendered) or expected (photos)
-  std::int64_t detected_frames = 0;  // ... where the tracker found it
+// Scored frames and how they were read: deliberate ones read as shown, non-deliberate ones
+// read as any gesture (a false positive).
+struct Reads {
   std::int64_t deliberate_scored = 0;
   std::int64_t deliberate_correct = 0;
   std::int64_t non_deliberate_scored = 0;
   std::int64_t false_positives = 0;
+
+  void score(contracts::GestureType truth, contracts::GestureType read, bool deliberate) {
+    if (deliberate) {
+      ++deliberate_scored;
+      if (read == truth) ++deliberate_correct;
+    } else {
+      ++non_deliberate_scored;
+      if (read != contracts::GestureType::kNone) ++false_positives;
+    }
+  }
+  void add(const Reads& o) {
+    deliberate_scored += o.deliberate_scored;
+    deliberate_correct += o.deliberate_correct;
+    non_deliberate_scored += o.non_deliberate_scored;
+    false_positives += o.false_positives;
+  }
+};
+
+struct Tally {
+  std::int64_t visible_frames = 0;   // hand fully visible (rendered) or expected (photos)
+  std::int64_t detected_frames = 0;  // ... where the tracker found it
+  Reads reads;  // what the tracker and recogniser read
   // The recogniser on the true landmarks of the same scored frames (rendered fixtures): what
   // the tracker could reach at best; below 1 means the pose or its label is at fault.
-  std::int64_t truth_deliberate_scored = 0;
-  std::int64_t truth_deliberate_correct = 0;
-  std::int64_t truth_non_deliberate_scored = 0;
-  std::int64_t truth_false_positives = 0;
+  Reads truth_reads;
   double landmark_error_sum_pct = 0;
   std::int64_t landmark_error_count = 0;
   double landmark_error_max_pct = 0;
@@ -43,14 +62,8 @@ struct Tally {
       for (const auto& [g, n] : counts) by_pose[pose][g] += n;
     visible_frames += o.visible_frames;
     detected_frames += o.detected_frames;
-    deliberate_scored += o.deliberate_scored;
-    deliberate_correct += o.deliberate_correct;
-    non_deliberate_scored += o.non_deliberate_scored;
-    false_positives += o.false_positives;
-    truth_deliberate_scored += o.truth_deliberate_scored;
-    truth_deliberate_correct += o.truth_deliberate_correct;
-    truth_non_deliberate_scored += o.truth_non_deliberate_scored;
-    truth_false_positives += o.truth_false_positives;
+    reads.add(o.reads);
+    truth_reads.add(o.truth_reads);
     landmark_error_sum_pct += o.landmark_error_sum_pct;
     landmark_error_count += o.landmark_error_count;
     landmark_error_max_pct = std::max(landmark_error_max_pct, o.landmark_error_max_pct);
@@ -61,24 +74,9 @@ struct Tally {
   }
   void score(contracts::GestureType truth, contracts::GestureType predicted, bool deliberate) {
     confusion[class_index(truth)][class_index(predicted)]++;
-    if (deliberate) {
-      ++deliberate_scored;
-      if (predicted == truth) ++deliberate_correct;
-    } else {
-      ++non_deliberate_scored;
-      if (predicted != contracts::GestureType::kNone) ++false_positives;
-    }
+    reads.score(truth, predicted, deliberate);
   }
-  void score_truth(contracts::GestureType truth, contracts::GestureType read, bool deliberate) {
-    if (deliberate) {
-      ++truth_deliberate_scored;
-      if (read == truth) ++truth_deliberate_correct;
-    } else {
-      ++truth_non_deliberate_scored;
-      if (read != contracts::GestureType::kNone) ++truth_false_positives;
-    }
-  }
-  std::int64_t scored() const { return deliberate_scored + non_deliberate_scored; }
+  std::int64_t scored() const { return reads.deliberate_scored + reads.non_deliberate_scored; }
   std::int64_t correct() const {
     std::int64_t c = 0;
     for (std::size_t i = 0; i < kClasses; ++i) c += confusion[i][i];
