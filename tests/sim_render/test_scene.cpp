@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <cmath>
 #include <fstream>
 #include <opencv2/imgproc.hpp>
@@ -47,9 +49,13 @@ ModelPtr load_model(const std::filesystem::path& path) {
 }
 
 ModelPtr load_test_scene() {
-  const auto path = temp_path("render_test_scene.xml");
+  // One file per process: ctest runs the renderer tests in parallel processes, and with one
+  // shared file a test could load another's half-written scene.
+  const auto path = temp_path("render_test_scene_" + std::to_string(::getpid()) + ".xml");
   std::ofstream(path) << kSceneXml;
-  return load_model(path);
+  ModelPtr model = load_model(path);
+  std::filesystem::remove(path);
+  return model;
 }
 
 std::filesystem::path quadrotor_model_path() {
