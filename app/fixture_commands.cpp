@@ -70,17 +70,8 @@ int run_still(const StillOptions& o) {
     std::filesystem::create_directories(dir);
   sim::HandScene scene(o.width, o.height);
   auto r = scene.render(hand);
-  // The hand over a plain grey, blended by its coverage (anti-aliased edges).
-  cv::Mat out(r.bgr.size(), CV_8UC3);
-  for (int y = 0; y < out.rows; ++y) {
-    for (int x = 0; x < out.cols; ++x) {
-      const double a = r.mask.at<unsigned char>(y, x) / 255.0;
-      const cv::Vec3b& h = r.bgr.at<cv::Vec3b>(y, x);
-      const cv::Vec3d grey(170, 180, 190);
-      for (int c = 0; c < 3; ++c)
-        out.at<cv::Vec3b>(y, x)[c] = cv::saturate_cast<unsigned char>(a * h[c] + (1 - a) * grey[c]);
-    }
-  }
+  cv::Mat out(r.bgr.size(), CV_8UC3, cv::Scalar(170, 180, 190));  // the hand over a plain grey
+  sim::composite_over(out, r);
   if (!o.overlay && !o.json) {
     sim::save_png(o.output, out);
     return 0;
