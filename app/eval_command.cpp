@@ -42,15 +42,31 @@ json read_json(const fs::path& path) {
   return contracts::parse_json(s.str());
 }
 
+// Distance between one landmark of two hands, in pixels.
+double distance_px(const contracts::Point3& a, const contracts::Point3& b, int w, int h) {
+  return std::hypot((a.x - b.x) * w, (a.y - b.y) * h);
+}
+
 // Mean distance between two hands in pixels.
-double mean_distance_px(const contracts::Landmarks& a, const json& truth, int w, int h) {
+double mean_distance_px(const contracts::Landmarks& a, const contracts::Landmarks& b, int w, int h) {
   double sum = 0;
-  for (std::size_t i = 0; i < contracts::kLandmarkCount; ++i) {
-    const double dx = (a.points[i].x - truth[i][0].get<double>()) * w;
-    const double dy = (a.points[i].y - truth[i][1].get<double>()) * h;
-    sum += std::hypot(dx, dy);
-  }
+  for (std::size_t i = 0; i < contracts::kLandmarkCount; ++i)
+    sum += distance_px(a.points[i], b.points[i], w, h);
   return sum / contracts::kLandmarkCount;
+}
+
+// A label's true landmarks ([x, y, z, visible] per point), if it has all 21.
+std::optional<contracts::Landmarks> true_landmarks(const json& label) {
+  if (!label.contains("landmarks")) return std::nullopt;
+  const json& gt = label["landmarks"];
+  if (!gt.is_array() || gt.size() != contracts::kLandmarkCount) return std::nullopt;
+  contracts::Landmarks hand;
+  for (std::size_t k = 0; k < contracts::kLandmarkCount; ++k) {
+    const json& q = gt[k];
+    hand.points[k] = {q[0].get<double>(), q[1].get<double>(), q.size() > 2 ? q[2].get<double>() : 0.0};
+  }
+  hand.score = 1;
+  return hand;
 }
 
 struct EvalOptions {
@@ -132,15 +148,15 @@ Tally eval_fixture(const fs::path& dir, vision::HandFinder& finder,
     const bool fully_visible = l.value("fully_visible", false);
     const auto truth = contracts::gesture_from_string(l.value("gesture", "NONE"))
                            .value_or(GestureType::kNone);
-    const json& gt = l.contains("landmarks") ? l["landmarks"] : json(nullptr);
+    const std::optional<contracts::Landmarks> true_hand = true_landmarks(l);
     // Which detected hand is the labelled one: the nearest to the ground truth, within half
     // the hand's size; without landmarks (recorded fixtures), the most present hand.
     const vision::HandResult* match = nullptr;
     double match_px = 0;
-    if (gt.is_array() && gt.size() == contracts::kLandmarkCount) {
+    if (true_hand) {
       const double size = l.value("hand_size_px", 0.0);
       for (const auto& h : hands) {
-        const double d = mean_distance_px(h.landmarks, gt, rgb.cols, rgb.rows);
+        const double d = mean_distance_px(h.landmarks, *true_hand, rgb.cols, rgb.rows);
         if ((match == nullptr || d < match_px) && d < 0.5 * size) {
           match = &h;
           match_px = d;
@@ -155,11 +171,10 @@ Tally eval_fixture(const fs::path& dir, vision::HandFinder& finder,
           ++t.landmark_error_count;
           t.landmark_error_max_pct = std::max(t.landmark_error_max_pct, pct);
           for (std::size_t k = 0; k < contracts::kLandmarkCount; ++k) {
-            t.point_error_sum_pct[k] +=
-                100.0 *
-                std::hypot((match->landmarks.points[k].x - gt[k][0].get<double>()) * rgb.cols,
-                           (match->landmarks.points[k].y - gt[k][1].get<double>()) * rgb.rows) /
-                std::max(1.0, size);
+            t.point_error_sum_pct[k] += 100.0 *
+                                         distance_px(match->landmarks.points[k],
+                                                     true_hand->points[k], rgb.cols, rgb.rows) /
+                                         std::max(1.0, size);
           }
         }
       }
@@ -176,7 +191,7 @@ Tally eval_fixture(const fs::path& dir, vision::HandFinder& finder,
     GestureType predicted = match != nullptr ? match->gesture : GestureType::kNone;
     if (deliberate) {
       // A gesture is judged where it can be seen whole.
-      if (!fully_visible && gt.is_array()) continue;
+      if (!fully_visible && true_hand) continue;
     } else {
       // Any gesture from any hand on a frame without a deliberate gesture is a false positive.
       for (const auto& h : hands)
@@ -184,16 +199,8 @@ Tally eval_fixture(const fs::path& dir, vision::HandFinder& finder,
     }
     const GestureType expected = deliberate ? truth : GestureType::kNone;
     t.score(expected, predicted, deliberate);
-    std::optional<contracts::Landmarks> true_hand;
     GestureType truth_read = GestureType::kNone;
-    if (gt.is_array() && gt.size() == contracts::kLandmarkCount) {
-      true_hand.emplace();
-      for (std::size_t k = 0; k < contracts::kLandmarkCount; ++k) {
-        const json& q = gt[k];
-        true_hand->points[k] = {q[0].get<double>(), q[1].get<double>(),
-                                q.size() > 2 ? q[2].get<double>() : 0.0};
-      }
-      true_hand->score = 1;
+    if (true_hand) {
       truth_read = classifier.recognize(*true_hand).gesture;
       t.truth_reads.score(expected, truth_read, deliberate);
     }
