@@ -1,6 +1,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <iterator>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 #include <string>
@@ -132,6 +135,69 @@ TEST(HandScene, OneSkinCoversTheHandAndFollowsTheJoints) {
   }
 }
 
+
+// The skin is retargeted from the sculpted WebXR hand mesh (ci/fetch-models puts it in the
+// build's models folder) so that each finger ends at its tip landmark, as MediaPipe's tips sit at
+// the finger's end: just inside the tip there is skin, a little beyond it (along the distal
+// phalanx) there is none. (The WebXR tip joint lies mid-pad; mapping it onto our tip made every
+// finger about 10 mm too long.)
+TEST(HandScene, SculptedFingersEndAtTheirTipLandmarks) {
+  ASSERT_NE(default_hand_mesh_path(), "") << "GBDCS_HAND_MESH=generated is set";
+  HandScene scene(640, 480);
+  std::mt19937 rng(3);
+  HandInstance hand;
+  hand.pose = pose_for(PoseName::kOpenPalm, rng);
+  hand.distance_m = 0.35;
+  const auto r = scene.render(hand);
+  const auto& pts = r.landmarks.points;
+  auto px = [](const auto& p) { return cv::Point2d(p.x * 640, p.y * 480); };
+  auto skin_at = [&](cv::Point2d q) {
+    const int x = static_cast<int>(std::lround(q.x)), y = static_cast<int>(std::lround(q.y));
+    return x >= 0 && x < 640 && y >= 0 && y < 480 && r.mask.at<unsigned char>(y, x) > 127;
+  };
+  for (int tip : {8, 12, 16, 20}) {
+    const cv::Point2d t = px(pts[tip]), d = px(pts[tip - 1]);
+    const cv::Point2d along = (t - d) * (1.0 / std::hypot(t.x - d.x, t.y - d.y));
+    const double mm_px = scene.focal_px() * 0.001 / hand.distance_m;  // 1 mm in pixels
+    EXPECT_TRUE(skin_at(t - along * (2 * mm_px))) << "landmark " << tip;
+    EXPECT_FALSE(skin_at(t + along * (3 * mm_px))) << "landmark " << tip;
+  }
+}
+
+// A hand mesh that is not a binary glTF, or is cut short, is refused with the file's name and
+// the fix; the generated skin stays available.
+TEST(HandScene, ABadHandMeshIsAClearError) {
+  const std::string bad = testing::TempDir() + "/not_a_hand.glb";
+  {
+    std::ofstream out(bad, std::ios::binary);
+    out << "solid hand\nendsolid\n";
+  }
+  const std::string cut = testing::TempDir() + "/cut_hand.glb";
+  {
+    std::ifstream in(default_hand_mesh_path(), std::ios::binary);
+    ASSERT_TRUE(in) << default_hand_mesh_path() << " missing: run ci/fetch-models";
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::ofstream out(cut, std::ios::binary);
+    out << bytes.substr(0, bytes.size() / 2);
+  }
+  for (const auto& [file, cause] : {std::pair{bad, "not a binary glTF"}, std::pair{cut, "truncated"}}) {
+    ::setenv("GBDCS_HAND_MESH", file.c_str(), 1);
+    try {
+      HandScene scene(160, 120);
+      ADD_FAILURE() << file << " was accepted";
+    } catch (const std::exception& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find(file), std::string::npos) << what;
+      EXPECT_NE(what.find(cause), std::string::npos) << what;
+      EXPECT_NE(what.find("ci/fetch-models"), std::string::npos) << what;
+    }
+  }
+  ::setenv("GBDCS_HAND_MESH", "generated", 1);
+  EXPECT_EQ(default_hand_mesh_path(), "");
+  HandScene generated(160, 120);
+  EXPECT_EQ(generated.model()->nskin, 1);
+  ::unsetenv("GBDCS_HAND_MESH");
+}
 
 // Edges are anti-aliased: the hand is drawn at kSupersample times the size and averaged down,
 // so its outline has pixels the hand covers only partly (the mask holds the coverage), and
