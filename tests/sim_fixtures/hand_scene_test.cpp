@@ -15,6 +15,15 @@
 namespace gbdcs::sim {
 namespace {
 
+// An open palm of the pose library (variant `seed`), facing the camera at `distance_m`.
+auto render_open_palm(HandScene& scene, unsigned seed, double distance_m) {
+  std::mt19937 rng(seed);
+  HandInstance hand;
+  hand.pose = pose_for(PoseName::kOpenPalm, rng);
+  hand.distance_m = distance_m;
+  return scene.render(hand);
+}
+
 // The MuJoCo hand's landmark sites, in the hand's own frame, are where the kinematic hand
 // of sim/landmarks puts them: the articulated model and the pose library agree joint for
 // joint, so a pose from the library renders as the hand it describes.
@@ -144,11 +153,8 @@ TEST(HandScene, OneSkinCoversTheHandAndFollowsTheJoints) {
 TEST(HandScene, SculptedFingersEndAtTheirTipLandmarks) {
   ASSERT_NE(default_hand_mesh_path(), "") << "GBDCS_HAND_MESH=generated is set";
   HandScene scene(640, 480);
-  std::mt19937 rng(3);
-  HandInstance hand;
-  hand.pose = pose_for(PoseName::kOpenPalm, rng);
-  hand.distance_m = 0.35;
-  const auto r = scene.render(hand);
+  constexpr double kDistance = 0.35;
+  const auto r = render_open_palm(scene, 3, kDistance);
   const auto& pts = r.landmarks.points;
   auto px = [](const auto& p) { return cv::Point2d(p.x * 640, p.y * 480); };
   auto skin_at = [&](cv::Point2d q) {
@@ -158,7 +164,7 @@ TEST(HandScene, SculptedFingersEndAtTheirTipLandmarks) {
   for (int tip : {8, 12, 16, 20}) {
     const cv::Point2d t = px(pts[tip]), d = px(pts[tip - 1]);
     const cv::Point2d along = (t - d) * (1.0 / std::hypot(t.x - d.x, t.y - d.y));
-    const double mm_px = scene.focal_px() * 0.001 / hand.distance_m;  // 1 mm in pixels
+    const double mm_px = scene.focal_px() * 0.001 / kDistance;  // 1 mm in pixels
     EXPECT_TRUE(skin_at(t - along * (2 * mm_px))) << "landmark " << tip;
     EXPECT_FALSE(skin_at(t + along * (3 * mm_px))) << "landmark " << tip;
   }
@@ -204,11 +210,7 @@ TEST(HandScene, ABadHandMeshIsAClearError) {
 // their colour is the hand's own, not darkened by the black the hand was drawn on.
 TEST(HandScene, EdgesAreAntiAliasedWithTheHandsOwnColour) {
   HandScene scene(320, 240);
-  std::mt19937 rng(5);
-  HandInstance h;
-  h.pose = pose_for(PoseName::kOpenPalm, rng);
-  h.distance_m = 0.5;
-  const auto r = scene.render(h);
+  const auto r = render_open_palm(scene, 5, 0.5);
   cv::Mat inside = r.mask == 255;
   cv::Mat edge = (r.mask > 0) & (r.mask < 255);
   const int edge_pixels = cv::countNonZero(edge);
