@@ -110,6 +110,7 @@ json frame_record(const fs::path& dir, const json& label, std::size_t frame, Ges
             {"predicted", contracts::to_string(predicted)},
             {"found", match != nullptr}};
   if (match != nullptr) {
+    r["confidence"] = match->confidence;
     r["tracked_features"] = features(match->landmarks);
     if (truth) r["landmark_error_pct"] = error_pct;
   }

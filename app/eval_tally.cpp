@@ -121,7 +121,7 @@ void print_classes(const json& s) {
   for (const auto& [name, c] : s["per_class"].items()) {
     std::cout << "  " << std::left << std::setw(12) << name << std::right << std::setw(11)
               << fmt_pct(c["precision"]) << std::setw(10) << fmt_pct(c["recall"]) << std::setw(8)
-              << c["support_frames"] << "\n";
+              << c["support_frames"].get<long>() << "\n";  // json's << reads setw as indent
   }
   std::cout << "\n  confusion (rows: truth, columns: predicted)\n  " << std::setw(12) << "";
   const auto& labels = s["confusion"]["labels"];

@@ -99,6 +99,7 @@ TEST(RecognizerAccuracyMeasure, FourFingersNeedTheThumbRule) {
   lenient.thumb_extended_min_lateral = -1.0;
   lenient.thumb_folded_max_lateral = -1.5;
   lenient.thumb_extended_max_bend_deg = 179;
+  lenient.thumb_aimed_min_lateral = -2.0;
   EXPECT_LT(measure(RuleBasedRecognizer(lenient), PoseName::kFourFingers, 11, 200).accuracy,
             0.5);
 }

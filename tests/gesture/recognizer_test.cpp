@@ -87,6 +87,110 @@ TEST(RuleBasedRecognizer, ConfidenceFallsTowardTheToleranceEdge) {
   EXPECT_GT(straight, tilted.confidence);
 }
 
+// The hand with its thumb (CMC to tip) moved across the palm, its shape unchanged, so that its
+// tip lies `lateral` palm sizes toward the index side (HandFeatures::thumb_lateral).
+Landmarks with_thumb_at(Landmarks hand, double lateral) {
+  namespace lm = contracts;
+  const auto lateral_of = [](const Landmarks& h) {
+    return extract_features(h, RuleBasedOptions{}.aspect_ratio, 1.0).thumb_lateral;
+  };
+  const lm::Point3 across{hand.points[lm::kIndexMcp].x - hand.points[lm::kPinkyMcp].x,
+                          hand.points[lm::kIndexMcp].y - hand.points[lm::kPinkyMcp].y,
+                          hand.points[lm::kIndexMcp].z - hand.points[lm::kPinkyMcp].z};
+  auto shifted = [&](double t) {
+    Landmarks h = hand;
+    for (auto k : {lm::kThumbCmc, lm::kThumbMcp, lm::kThumbIp, lm::kThumbTip}) {
+      h.points[k].x += t * across.x;
+      h.points[k].y += t * across.y;
+      h.points[k].z += t * across.z;
+    }
+    return h;
+  };
+  const double now = lateral_of(hand), per_unit = lateral_of(shifted(1)) - now;  // linear in t
+  return shifted((lateral - now) / per_unit);
+}
+
+// The hand with its thumb straightened: IP and tip carried on along CMC -> MCP, bones kept.
+Landmarks with_straight_thumb(Landmarks hand) {
+  namespace lm = contracts;
+  auto& p = hand.points;
+  const auto sub = [](lm::Point3 a, lm::Point3 b) { return lm::Point3{a.x - b.x, a.y - b.y, a.z - b.z}; };
+  const auto len = [](lm::Point3 a) { return std::sqrt(a.x * a.x + a.y * a.y + a.z * a.z); };
+  const lm::Point3 d = sub(p[lm::kThumbMcp], p[lm::kThumbCmc]);
+  const double unit = len(d);
+  const double to_ip = len(sub(p[lm::kThumbIp], p[lm::kThumbMcp]));
+  const double to_tip = to_ip + len(sub(p[lm::kThumbTip], p[lm::kThumbIp]));
+  for (auto [k, along] : {std::pair{lm::kThumbIp, to_ip}, std::pair{lm::kThumbTip, to_tip}}) {
+    p[k] = {p[lm::kThumbMcp].x + d.x * along / unit, p[lm::kThumbMcp].y + d.y * along / unit,
+            p[lm::kThumbMcp].z + d.z * along / unit};
+  }
+  return hand;
+}
+
+// A thumb tucked beside the index or hidden behind the hand reads neither folded nor out; the
+// pointing and victory shapes need it only not out. Clearly out, it is the "L" (not a gesture).
+TEST(RuleBasedRecognizer, PointingAndVictoryNeedTheThumbOnlyNotOut) {
+  const RuleBasedRecognizer recognizer;
+  const RuleBasedOptions o;
+  std::mt19937 rng(31);
+  for (int i = 0; i < 10; ++i) {
+    sim::HandPose up = sim::pose_for(PoseName::kPointUp, rng);
+    up.orientation.aim_deg = 0;
+    const Landmarks folded = with_straight_thumb(place(up));
+    const Recognition sure = recognizer.recognize(with_thumb_at(folded, 0));
+    ASSERT_EQ(sure.gesture, GestureType::kPointUp);
+    const double between = (o.thumb_folded_max_lateral + o.thumb_extended_min_lateral) / 2;
+    const Landmarks tucked = with_thumb_at(folded, between);
+    ASSERT_NEAR(extract_features(tucked, o.aspect_ratio, 1).thumb_lateral, between, 1e-6);
+    ASSERT_LT(extract_features(tucked, o.aspect_ratio, 1).thumb_bend_deg, 1);
+    const Recognition r = recognizer.recognize(tucked);
+    EXPECT_EQ(r.gesture, GestureType::kPointUp);
+    EXPECT_LT(r.confidence, sure.confidence);  // the thumb's doubt shows
+    EXPECT_EQ(recognizer.recognize(with_thumb_at(folded, 1.0)).gesture, GestureType::kNone);
+
+    const Landmarks victory = with_straight_thumb(place(sim::pose_for(PoseName::kVictory, rng)));
+    ASSERT_EQ(recognizer.recognize(with_thumb_at(victory, 0)).gesture, GestureType::kVictory);
+    EXPECT_EQ(recognizer.recognize(with_thumb_at(victory, between)).gesture, GestureType::kVictory);
+    EXPECT_EQ(recognizer.recognize(with_thumb_at(victory, 1.0)).gesture, GestureType::kNone);
+  }
+}
+
+// Seen end-on, a raised thumb's tip is placed over the folded fingers by the tracker: a
+// straight thumb aimed up or down over four folded fingers is the thumb gesture, unless its
+// tip lies past the palm's middle (a thumb across a fist) or it points sideways.
+TEST(RuleBasedRecognizer, AStraightThumbAimedUpOverFoldedFingersIsAThumbGesture) {
+  const RuleBasedRecognizer recognizer;
+  const RuleBasedOptions o;
+  std::mt19937 rng(32);
+  for (int i = 0; i < 10; ++i) {
+    sim::HandPose thumb = sim::pose_for(PoseName::kThumbUp, rng);
+    thumb.orientation.aim_deg = 0;
+    const Landmarks out = place(thumb);
+    ASSERT_EQ(recognizer.recognize(out).gesture, GestureType::kThumbUp);
+    ASSERT_LT(extract_features(out, o.aspect_ratio, 1).thumb_bend_deg, o.thumb_aimed_max_bend_deg);
+    const double over = o.thumb_folded_max_lateral / 2;  // read "folded" by its tip
+    EXPECT_EQ(recognizer.recognize(with_thumb_at(out, over)).gesture, GestureType::kThumbUp);
+    EXPECT_EQ(recognizer.recognize(place(thumb, 180)).gesture, GestureType::kThumbDown);
+    EXPECT_EQ(recognizer.recognize(with_thumb_at(place(thumb, 180), over)).gesture,
+              GestureType::kThumbDown);
+    // Across the palm, or lying sideways: a fist.
+    EXPECT_EQ(recognizer.recognize(with_thumb_at(out, -0.2)).gesture, GestureType::kFist);
+    EXPECT_EQ(recognizer.recognize(with_thumb_at(place(thumb, 90), over)).gesture,
+              GestureType::kFist);
+    RuleBasedOptions off;
+    off.thumb_aimed_max_bend_deg = 0;
+    EXPECT_EQ(RuleBasedRecognizer(off).recognize(with_thumb_at(out, over)).gesture,
+              GestureType::kFist);
+  }
+  // The library's fists (thumb bent across the fingers) stay fists at every roll.
+  for (int i = 0; i < 20; ++i) {
+    const sim::HandPose fist = sim::pose_for(PoseName::kFist, rng);
+    for (double roll : {0.0, 90.0, 180.0, -90.0}) {
+      EXPECT_EQ(recognizer.recognize(place(fist, roll)).gesture, GestureType::kFist) << roll;
+    }
+  }
+}
+
 TEST(RuleBasedRecognizer, LowPresenceLowersConfidence) {
   const RuleBasedRecognizer recognizer;
   std::mt19937 rng(3);
@@ -176,6 +280,8 @@ TEST(RuleBasedOptions, RejectsUnknownKeysWrongTypesAndBadValues) {
   expect_rejected({{"finger_folded_min_curl_deg", 30}}, "finger_folded_min_curl_deg");
   expect_rejected({{"aspect_ratio", -1}}, "aspect_ratio");
   expect_rejected({{"min_presence", 0.9}}, "min_presence");
+  expect_rejected({{"thumb_aimed_max_bend_deg", 60}}, "thumb_aimed_max_bend_deg");
+  expect_rejected({{"thumb_aimed_min_lateral", 0.5}}, "thumb_aimed_min_lateral");
   EXPECT_THROW(rule_based_options_from_json(nlohmann::json::array()), std::invalid_argument);
   RuleBasedOptions bad;
   bad.angle_transition_deg = 0;

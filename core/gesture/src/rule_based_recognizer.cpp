@@ -24,6 +24,7 @@ constexpr Digit kF = Digit::kFolded;
 struct Reading {
   Digit state = Digit::kUnclear;
   double confidence = 0;
+  double extended = 0;  // the thumb's evidence for extended (>= 0 when it is)
 };
 
 // Evidence is the distance past a threshold in transition widths (>= 0 when passed).
@@ -44,9 +45,9 @@ Reading read_thumb(const HandFeatures& f, const RuleBasedOptions& o) {
       std::min((f.thumb_lateral - o.thumb_extended_min_lateral) / o.lateral_transition,
                (o.thumb_extended_max_bend_deg - f.thumb_bend_deg) / o.angle_transition_deg);
   const double folded = (o.thumb_folded_max_lateral - f.thumb_lateral) / o.lateral_transition;
-  if (extended >= 0) return {Digit::kExtended, margin_confidence(extended)};
-  if (folded >= 0) return {Digit::kFolded, margin_confidence(folded)};
-  return {};
+  if (extended >= 0) return {Digit::kExtended, margin_confidence(extended), extended};
+  if (folded >= 0) return {Digit::kFolded, margin_confidence(folded), extended};
+  return {Digit::kUnclear, 0, extended};
 }
 
 struct Target {
@@ -83,6 +84,8 @@ RuleBasedOptions rule_based_options_from_json(const nlohmann::json& doc) {
   r.read("thumb_extended_min_lateral", o.thumb_extended_min_lateral);
   r.read("thumb_folded_max_lateral", o.thumb_folded_max_lateral);
   r.read("thumb_extended_max_bend_deg", o.thumb_extended_max_bend_deg);
+  r.read("thumb_aimed_max_bend_deg", o.thumb_aimed_max_bend_deg);
+  r.read("thumb_aimed_min_lateral", o.thumb_aimed_min_lateral);
   r.read("victory_min_spread_deg", o.victory_min_spread_deg);
   r.read("direction_tolerance_deg", o.direction_tolerance_deg);
   r.read("direction_min_in_plane", o.direction_min_in_plane);
@@ -103,6 +106,8 @@ nlohmann::json to_json(const RuleBasedOptions& o) {
           {"thumb_extended_min_lateral", o.thumb_extended_min_lateral},
           {"thumb_folded_max_lateral", o.thumb_folded_max_lateral},
           {"thumb_extended_max_bend_deg", o.thumb_extended_max_bend_deg},
+          {"thumb_aimed_max_bend_deg", o.thumb_aimed_max_bend_deg},
+          {"thumb_aimed_min_lateral", o.thumb_aimed_min_lateral},
           {"victory_min_spread_deg", o.victory_min_spread_deg},
           {"direction_tolerance_deg", o.direction_tolerance_deg},
           {"direction_min_in_plane", o.direction_min_in_plane},
@@ -131,6 +136,11 @@ void validate(const RuleBasedOptions& o) {
           "thumb_folded_max_lateral", "must be below thumb_extended_min_lateral");
   require(o.thumb_extended_max_bend_deg > 0 && o.thumb_extended_max_bend_deg < 180, kOwner,
           "thumb_extended_max_bend_deg", "must be in (0, 180)");
+  require(o.thumb_aimed_max_bend_deg >= 0 && o.thumb_aimed_max_bend_deg <= o.thumb_extended_max_bend_deg,
+          kOwner, "thumb_aimed_max_bend_deg",
+          "must be in [0, thumb_extended_max_bend_deg] (0 turns the rule off)");
+  require(o.thumb_aimed_min_lateral < o.thumb_extended_min_lateral, kOwner,
+          "thumb_aimed_min_lateral", "must be below thumb_extended_min_lateral");
   require(o.victory_min_spread_deg >= 0 && o.victory_min_spread_deg < 90, kOwner,
           "victory_min_spread_deg", "must be in [0, 90)");
   require(o.direction_tolerance_deg > 0 && o.direction_tolerance_deg < 45, kOwner,
@@ -160,13 +170,28 @@ Recognition RuleBasedRecognizer::recognize(const contracts::Landmarks& hand) con
   std::array<Reading, 5> digits{read_thumb(f, o)};
   for (std::size_t i = 0; i < 4; ++i) digits[i + 1] = read_finger(f.finger_curl_deg[i], o);
 
-  auto shape = [&digits](std::array<Digit, 5> want) -> std::optional<double> {
+  // The four fingers as wanted: the smallest of their confidences.
+  auto fingers = [&digits](std::array<Digit, 4> want) -> std::optional<double> {
     double confidence = 1;
     for (std::size_t i = 0; i < want.size(); ++i) {
-      if (digits[i].state != want[i]) return std::nullopt;
-      confidence = std::min(confidence, digits[i].confidence);
+      if (digits[i + 1].state != want[i]) return std::nullopt;
+      confidence = std::min(confidence, digits[i + 1].confidence);
     }
     return confidence;
+  };
+  auto shape = [&](Digit thumb, std::array<Digit, 4> want) -> std::optional<double> {
+    const auto c = fingers(want);
+    if (!c || digits[0].state != thumb) return std::nullopt;
+    return std::min(*c, digits[0].confidence);
+  };
+  // For pointing and victory the thumb only has to be not out: a thumb read unclear (tucked
+  // beside the index, or hidden behind the hand) counts, with the margin by which it misses
+  // "extended" as its confidence.
+  auto shape_thumb_in = [&](std::array<Digit, 4> want) -> std::optional<double> {
+    const auto c = fingers(want);
+    if (!c || digits[0].state == kE) return std::nullopt;
+    return std::min(*c, digits[0].state == kF ? digits[0].confidence
+                                              : margin_confidence(-digits[0].extended));
   };
   auto scaled = [presence](Recognition r) {
     r.confidence *= presence;
@@ -177,23 +202,38 @@ Recognition RuleBasedRecognizer::recognize(const contracts::Landmarks& hand) con
     r->confidence = std::min(r->confidence, shape_confidence);
     return scaled(*r);
   };
+  auto thumb_gesture = [&] {
+    return match_direction(f.thumb_direction_deg, f.thumb_in_plane,
+                           {{0, GestureType::kThumbUp}, {180, GestureType::kThumbDown}}, o);
+  };
 
-  if (auto c = shape({kE, kE, kE, kE, kE})) return scaled({GestureType::kOpenPalm, *c});
-  if (auto c = shape({kF, kF, kF, kF, kF})) return scaled({GestureType::kFist, *c});
-  if (auto c = shape({kE, kE, kF, kF, kE})) return scaled({GestureType::kILoveYou, *c});
-  if (auto c = shape({kF, kE, kE, kF, kF})) {
+  if (auto c = shape(kE, {kE, kE, kE, kE})) return scaled({GestureType::kOpenPalm, *c});
+  // Four folded fingers and a straight thumb aimed up or down, its tip on its own side of the
+  // palm: the thumb gesture, even where the tip reads as over the fist (seen end-on, the
+  // tracker places a raised thumb's tip over the folded fingers). A thumb folded into a fist
+  // is bent, or lies across the fingers with its tip past the palm's middle.
+  if (const auto c = fingers({kF, kF, kF, kF}); c && digits[0].state != kE) {
+    const double straight =
+        (o.thumb_aimed_max_bend_deg - f.thumb_bend_deg) / o.angle_transition_deg;
+    const double beside = (f.thumb_lateral - o.thumb_aimed_min_lateral) / o.lateral_transition;
+    if (o.thumb_aimed_max_bend_deg > 0 && straight >= 0 && beside >= 0) {
+      if (auto r = thumb_gesture()) {
+        r->confidence = std::min(
+            {r->confidence, margin_confidence(straight), margin_confidence(beside)});
+        return with_shape(r, *c);
+      }
+    }
+  }
+  if (auto c = shape(kF, {kF, kF, kF, kF})) return scaled({GestureType::kFist, *c});
+  if (auto c = shape(kE, {kE, kF, kF, kE})) return scaled({GestureType::kILoveYou, *c});
+  if (auto c = shape_thumb_in({kE, kE, kF, kF})) {
     const double spread = (f.index_middle_spread_deg - o.victory_min_spread_deg) /
                           o.angle_transition_deg;
     if (spread < 0) return {GestureType::kNone, presence};  // two fingers together
     return scaled({GestureType::kVictory, std::min(*c, margin_confidence(spread))});
   }
-  if (auto c = shape({kE, kF, kF, kF, kF})) {
-    return with_shape(match_direction(f.thumb_direction_deg, f.thumb_in_plane,
-                                      {{0, GestureType::kThumbUp}, {180, GestureType::kThumbDown}},
-                                      o),
-                      *c);
-  }
-  if (auto c = shape({kF, kE, kF, kF, kF})) {
+  if (auto c = shape(kE, {kF, kF, kF, kF})) return with_shape(thumb_gesture(), *c);
+  if (auto c = shape_thumb_in({kE, kF, kF, kF})) {
     return with_shape(match_direction(f.index_direction_deg, f.index_in_plane,
                                       {{-90, GestureType::kPointLeft},
                                        {90, GestureType::kPointRight},

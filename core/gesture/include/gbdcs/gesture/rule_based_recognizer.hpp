@@ -8,6 +8,12 @@
 //            THUMB_UP    thumb only, pointing up    THUMB_DOWN  thumb only, pointing down
 //            POINT_LEFT / POINT_RIGHT / POINT_UP    index only, pointing that way in the image
 //            VICTORY     index + middle, spread     I_LOVE_YOU  thumb + index + pinky
+//          Pointing and victory need the thumb only not extended (an unclear thumb counts,
+//          with the margin by which it misses "extended" as its confidence). Four folded
+//          fingers with a straight thumb (bend <= thumb_aimed_max_bend_deg) aimed up or down,
+//          its tip at least thumb_aimed_min_lateral toward the index side, read as the thumb
+//          gesture even when the tip's lateral position says folded (a raised thumb seen
+//          end-on); a fist's own thumb is bent or lies across the fingers.
 //          Anything else is NONE: four fingers with the thumb folded, call, rock, OK, pinch,
 //          half-closed, relaxed, an unclear digit, a direction off by more than the
 //          tolerance. Shape gestures are invariant to scale, in-plane rotation and
@@ -22,7 +28,9 @@
 //   aspect_ratio 4/3 (frame width / height), depth_weight 1 (trust in z, [0, 1]),
 //   finger_extended_max_curl_deg 35, finger_folded_min_curl_deg 100,
 //   thumb_extended_min_lateral 0.45 and thumb_folded_max_lateral 0.3 (palm sizes),
-//   thumb_extended_max_bend_deg 45, victory_min_spread_deg 10,
+//   thumb_extended_max_bend_deg 45, thumb_aimed_max_bend_deg 30 ([0, the extended limit];
+//   0 turns the aimed-thumb rule off), thumb_aimed_min_lateral 0 (below the extended limit),
+//   victory_min_spread_deg 10,
 //   direction_tolerance_deg 35 (< 45 so that directions cannot overlap),
 //   direction_min_in_plane 0.5 (a digit aimed at the camera has no image direction),
 //   angle_transition_deg 15, lateral_transition 0.2, min_presence 0.2, full_presence 0.8.
@@ -43,6 +51,8 @@ struct RuleBasedOptions {
   double thumb_extended_min_lateral = 0.45;
   double thumb_folded_max_lateral = 0.3;
   double thumb_extended_max_bend_deg = 45;
+  double thumb_aimed_max_bend_deg = 30;
+  double thumb_aimed_min_lateral = 0;
   double victory_min_spread_deg = 10;
   double direction_tolerance_deg = 35;
   double direction_min_in_plane = 0.5;
