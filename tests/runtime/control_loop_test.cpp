@@ -196,7 +196,16 @@ TEST_F(LoopTest, BatteryCriticalLandsAndBlocksTakeoff) {
 TEST_F(LoopTest, StorageRecordsEverything) {
   const auto path = std::filesystem::temp_directory_path() /
                     ("gbdcs_loop_" + std::to_string(::getpid()) + ".db");
-  std::filesystem::remove(path);
+  // Removes the database with its WAL and shared-memory files, before the test and (declared
+  // before the storage, so destroyed after it has closed them) after.
+  struct Cleanup {
+    std::filesystem::path db;
+    void remove() const {
+      for (const char* suffix : {"", "-wal", "-shm"}) std::filesystem::remove(db.string() + suffix);
+    }
+    ~Cleanup() { remove(); }
+  } cleanup{path};
+  cleanup.remove();
   storage::StorageOptions so;
   so.path = path.string();
   storage::StorageManager storage(so, clock);
@@ -210,7 +219,6 @@ TEST_F(LoopTest, StorageRecordsEverything) {
   EXPECT_EQ(storage.commands(session).size(), recorder->commands.size());
   EXPECT_GT(storage.telemetry(session).size(), 50u);
   EXPECT_EQ(storage.alerts(session).size(), recorder->alerts.size());
-  std::filesystem::remove(path);
 }
 
 }  // namespace
