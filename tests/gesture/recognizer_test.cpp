@@ -191,6 +191,31 @@ TEST(RuleBasedRecognizer, AStraightThumbAimedUpOverFoldedFingersIsAThumbGesture)
   }
 }
 
+// A fist's thumb is bent: lying beside the index (tip between the limits) it still makes a
+// fist. Straight there and not aimed, or read out, it stays unclear (FIST is LAND).
+TEST(RuleBasedRecognizer, AFistWithItsBentThumbBesideTheIndexIsAFist) {
+  const RuleBasedRecognizer recognizer;
+  const RuleBasedOptions o;
+  const double between = (o.thumb_folded_max_lateral + o.thumb_extended_min_lateral) / 2;
+  std::mt19937 rng(33);
+  int bent_cases = 0;
+  for (int i = 0; i < 40; ++i) {
+    const Landmarks fist = place(sim::pose_for(PoseName::kFist, rng));
+    ASSERT_EQ(recognizer.recognize(fist).gesture, GestureType::kFist);
+    if (extract_features(fist, o.aspect_ratio, 1).thumb_bend_deg < o.thumb_extended_max_bend_deg + 5)
+      continue;
+    ++bent_cases;
+    const Recognition beside = recognizer.recognize(with_thumb_at(fist, between));
+    EXPECT_EQ(beside.gesture, GestureType::kFist);
+    EXPECT_GT(beside.confidence, 0);
+    EXPECT_EQ(recognizer.recognize(with_thumb_at(fist, 1.0)).gesture, GestureType::kNone);
+    // Straightened and turned sideways (not aimed up or down): unclear.
+    const Landmarks sideways = with_thumb_at(with_straight_thumb(place(sim::pose_for(PoseName::kFist, rng), 90)), between);
+    EXPECT_EQ(recognizer.recognize(sideways).gesture, GestureType::kNone);
+  }
+  EXPECT_GE(bent_cases, 10);
+}
+
 TEST(RuleBasedRecognizer, LowPresenceLowersConfidence) {
   const RuleBasedRecognizer recognizer;
   std::mt19937 rng(3);

@@ -225,6 +225,15 @@ Recognition RuleBasedRecognizer::recognize(const contracts::Landmarks& hand) con
     }
   }
   if (auto c = shape(kF, {kF, kF, kF, kF})) return scaled({GestureType::kFist, *c});
+  // A fist whose thumb lies beside the index (tip between the limits) is one when the thumb is
+  // bent, as a fist's thumb is: the straight ones were taken by the aimed-thumb rule above, or
+  // stay unclear. A thumb read out and hooked stays unclear (FIST is LAND).
+  if (const auto c = fingers({kF, kF, kF, kF});
+      c && digits[0].state == Digit::kUnclear && f.thumb_lateral < o.thumb_extended_min_lateral) {
+    const double bent =
+        (f.thumb_bend_deg - o.thumb_extended_max_bend_deg) / o.angle_transition_deg;
+    if (bent >= 0) return scaled({GestureType::kFist, std::min(*c, margin_confidence(bent))});
+  }
   if (auto c = shape(kE, {kE, kF, kF, kE})) return scaled({GestureType::kILoveYou, *c});
   if (auto c = shape_thumb_in({kE, kE, kF, kF})) {
     const double spread = (f.index_middle_spread_deg - o.victory_min_spread_deg) /

@@ -13,7 +13,9 @@
 //          fingers with a straight thumb (bend <= thumb_aimed_max_bend_deg) aimed up or down,
 //          its tip at least thumb_aimed_min_lateral toward the index side, read as the thumb
 //          gesture even when the tip's lateral position says folded (a raised thumb seen
-//          end-on); a fist's own thumb is bent or lies across the fingers.
+//          end-on); a fist's own thumb is bent or lies across the fingers. Four folded
+//          fingers with a bent thumb (bend >= thumb_extended_max_bend_deg) whose tip lies
+//          between the limits (beside the index) are a FIST.
 //          Anything else is NONE: four fingers with the thumb folded, call, rock, OK, pinch,
 //          half-closed, relaxed, an unclear digit, a direction off by more than the
 //          tolerance. Shape gestures are invariant to scale, in-plane rotation and
