@@ -87,6 +87,18 @@ TEST(RuleBasedRecognizer, ConfidenceFallsTowardTheToleranceEdge) {
   EXPECT_GT(straight, tilted.confidence);
 }
 
+// A library pose of that gesture aimed exactly up, without the library's aim noise.
+sim::HandPose upright(PoseName name, std::mt19937& rng) {
+  sim::HandPose pose = sim::pose_for(name, rng);
+  pose.orientation.aim_deg = 0;
+  return pose;
+}
+
+// Halfway between the thumb's "folded" and "extended" limits of lateral position.
+double between_the_limits(const RuleBasedOptions& o) {
+  return (o.thumb_folded_max_lateral + o.thumb_extended_min_lateral) / 2;
+}
+
 // The hand with its thumb (CMC to tip) moved across the palm, its shape unchanged, so that its
 // tip lies `lateral` palm sizes toward the index side (HandFeatures::thumb_lateral).
 Landmarks with_thumb_at(Landmarks hand, double lateral) {
@@ -132,14 +144,12 @@ Landmarks with_straight_thumb(Landmarks hand) {
 TEST(RuleBasedRecognizer, PointingAndVictoryNeedTheThumbOnlyNotOut) {
   const RuleBasedRecognizer recognizer;
   const RuleBasedOptions o;
+  const double between = between_the_limits(o);
   std::mt19937 rng(31);
   for (int i = 0; i < 10; ++i) {
-    sim::HandPose up = sim::pose_for(PoseName::kPointUp, rng);
-    up.orientation.aim_deg = 0;
-    const Landmarks folded = with_straight_thumb(place(up));
+    const Landmarks folded = with_straight_thumb(place(upright(PoseName::kPointUp, rng)));
     const Recognition sure = recognizer.recognize(with_thumb_at(folded, 0));
     ASSERT_EQ(sure.gesture, GestureType::kPointUp);
-    const double between = (o.thumb_folded_max_lateral + o.thumb_extended_min_lateral) / 2;
     const Landmarks tucked = with_thumb_at(folded, between);
     ASSERT_NEAR(extract_features(tucked, o.aspect_ratio, 1).thumb_lateral, between, 1e-6);
     ASSERT_LT(extract_features(tucked, o.aspect_ratio, 1).thumb_bend_deg, 1);
@@ -163,8 +173,7 @@ TEST(RuleBasedRecognizer, AStraightThumbAimedUpOverFoldedFingersIsAThumbGesture)
   const RuleBasedOptions o;
   std::mt19937 rng(32);
   for (int i = 0; i < 10; ++i) {
-    sim::HandPose thumb = sim::pose_for(PoseName::kThumbUp, rng);
-    thumb.orientation.aim_deg = 0;
+    const sim::HandPose thumb = upright(PoseName::kThumbUp, rng);
     const Landmarks out = place(thumb);
     ASSERT_EQ(recognizer.recognize(out).gesture, GestureType::kThumbUp);
     ASSERT_LT(extract_features(out, o.aspect_ratio, 1).thumb_bend_deg, o.thumb_aimed_max_bend_deg);
@@ -196,7 +205,7 @@ TEST(RuleBasedRecognizer, AStraightThumbAimedUpOverFoldedFingersIsAThumbGesture)
 TEST(RuleBasedRecognizer, AFistWithItsBentThumbBesideTheIndexIsAFist) {
   const RuleBasedRecognizer recognizer;
   const RuleBasedOptions o;
-  const double between = (o.thumb_folded_max_lateral + o.thumb_extended_min_lateral) / 2;
+  const double between = between_the_limits(o);
   std::mt19937 rng(33);
   int bent_cases = 0;
   for (int i = 0; i < 40; ++i) {
