@@ -208,11 +208,14 @@ Recognition RuleBasedRecognizer::recognize(const contracts::Landmarks& hand) con
   };
 
   if (auto c = shape(kE, {kE, kE, kE, kE})) return scaled({GestureType::kOpenPalm, *c});
-  // Four folded fingers and a straight thumb aimed up or down, its tip on its own side of the
-  // palm: the thumb gesture, even where the tip reads as over the fist (seen end-on, the
-  // tracker places a raised thumb's tip over the folded fingers). A thumb folded into a fist
-  // is bent, or lies across the fingers with its tip past the palm's middle.
-  if (const auto c = fingers({kF, kF, kF, kF}); c && digits[0].state != kE) {
+  // Four folded fingers: a fist or a thumb gesture, decided by the thumb.
+  if (const auto c = fingers({kF, kF, kF, kF})) {
+    const Reading& thumb = digits[0];
+    if (thumb.state == kE) return with_shape(thumb_gesture(), std::min(*c, thumb.confidence));
+    // A straight thumb aimed up or down, its tip on its own side of the palm: the thumb
+    // gesture, even where the tip reads as over the fist (seen end-on, the tracker places a
+    // raised thumb's tip over the folded fingers). A fist's own thumb is bent, or lies across
+    // the fingers with its tip past the palm's middle.
     const double straight =
         (o.thumb_aimed_max_bend_deg - f.thumb_bend_deg) / o.angle_transition_deg;
     const double beside = (f.thumb_lateral - o.thumb_aimed_min_lateral) / o.lateral_transition;
@@ -223,16 +226,15 @@ Recognition RuleBasedRecognizer::recognize(const contracts::Landmarks& hand) con
         return with_shape(r, *c);
       }
     }
-  }
-  if (auto c = shape(kF, {kF, kF, kF, kF})) return scaled({GestureType::kFist, *c});
-  // A fist whose thumb lies beside the index (tip between the limits) is one when the thumb is
-  // bent, as a fist's thumb is: the straight ones were taken by the aimed-thumb rule above, or
-  // stay unclear. A thumb read out and hooked stays unclear (FIST is LAND).
-  if (const auto c = fingers({kF, kF, kF, kF});
-      c && digits[0].state == Digit::kUnclear && f.thumb_lateral < o.thumb_extended_min_lateral) {
+    if (thumb.state == kF) return scaled({GestureType::kFist, std::min(*c, thumb.confidence)});
+    // A thumb beside the index (tip between the limits) makes a fist when it is bent, as a
+    // fist's thumb is; a straight one there stays unclear, and so does a hooked thumb read out
+    // (FIST is LAND).
     const double bent =
         (f.thumb_bend_deg - o.thumb_extended_max_bend_deg) / o.angle_transition_deg;
-    if (bent >= 0) return scaled({GestureType::kFist, std::min(*c, margin_confidence(bent))});
+    if (f.thumb_lateral < o.thumb_extended_min_lateral && bent >= 0)
+      return scaled({GestureType::kFist, std::min(*c, margin_confidence(bent))});
+    return {GestureType::kNone, presence};
   }
   if (auto c = shape(kE, {kE, kF, kF, kE})) return scaled({GestureType::kILoveYou, *c});
   if (auto c = shape_thumb_in({kE, kE, kF, kF})) {
@@ -241,7 +243,6 @@ Recognition RuleBasedRecognizer::recognize(const contracts::Landmarks& hand) con
     if (spread < 0) return {GestureType::kNone, presence};  // two fingers together
     return scaled({GestureType::kVictory, std::min(*c, margin_confidence(spread))});
   }
-  if (auto c = shape(kE, {kF, kF, kF, kF})) return with_shape(thumb_gesture(), *c);
   if (auto c = shape_thumb_in({kE, kF, kF, kF})) {
     return with_shape(match_direction(f.index_direction_deg, f.index_in_plane,
                                       {{-90, GestureType::kPointLeft},
