@@ -77,6 +77,7 @@ struct EvalOptions {
   bool check = false;
   bool per_fixture = false;
   std::string frames_out;
+  std::string recognizer_file;  // RuleBasedOptions JSON; empty = the defaults
   double min_detection = 0.98;
   double max_landmark_error_pct = 3.0;
   double min_accuracy = 0.97;
@@ -334,7 +335,17 @@ int run_eval(const EvalOptions& o) {
     return 2;
   }
   contracts::SteadyClock clock;
-  vision::HandClassifier classifier;
+  gesture::RuleBasedOptions recognizer;
+  if (!o.recognizer_file.empty()) {
+    const json doc = read_json(o.recognizer_file);
+    const bool pipeline_file = doc.is_object() && doc.contains("recognizer");
+    try {
+      recognizer = gesture::rule_based_options_from_json(pipeline_file ? doc["recognizer"] : doc);
+    } catch (const std::invalid_argument& e) {
+      throw std::runtime_error(o.recognizer_file + ": " + e.what());
+    }
+  }
+  vision::HandClassifier classifier(recognizer);
   Tally total;
   json sources = json::array();
   // Resolve the inputs: fixture folders, recipes (rendered into the cache), folders of
@@ -458,6 +469,11 @@ void add_eval_command(CLI::App& app) {
                    "Write one JSON line per scored fixture frame to this file: pose, expected and "
                    "predicted gesture, the recogniser's features on the tracked and on the true "
                    "landmarks, landmark error (to find why a pose is misread)");
+  eval->add_option("--recognizer", o.recognizer_file,
+                   "The rule-based recogniser's options (JSON: an object of RuleBasedOptions, or "
+                   "a PipelineOptions file with a \"recognizer\" key; docs/GESTURES.md), to "
+                   "measure a change of them before it goes into a profile")
+      ->check(CLI::ExistingFile);
   eval->add_flag("--check", o.check,
                  "Exit 1 unless the targets are met (docs/ACCURACY.md): detection, landmark "
                  "error, deliberate accuracy, false positives");

@@ -139,6 +139,73 @@ Landmarks with_straight_thumb(Landmarks hand) {
   return hand;
 }
 
+// The hand with one finger (0 = index .. 3 = little) turned about its knuckle, in the plane of
+// the palm's axis and its knuckle -> tip chord, until its curl (HandFeatures) is `curl_deg`.
+Landmarks with_finger_curl(Landmarks hand, int finger, double curl_deg) {
+  namespace lm = contracts;
+  const double a = RuleBasedOptions{}.aspect_ratio;  // the features' frame: x and z times a
+  struct V { double x, y, z; };
+  const auto to = [a](lm::Point3 q) { return V{q.x * a, q.y, q.z * a}; };
+  const auto sub = [](V p, V q) { return V{p.x - q.x, p.y - q.y, p.z - q.z}; };
+  const auto dot = [](V p, V q) { return p.x * q.x + p.y * q.y + p.z * q.z; };
+  const auto cross = [](V p, V q) {
+    return V{p.y * q.z - p.z * q.y, p.z * q.x - p.x * q.z, p.x * q.y - p.y * q.x};
+  };
+  const std::size_t mcp = lm::kIndexMcp + 4 * static_cast<std::size_t>(finger);
+  auto& p = hand.points;
+  const V knuckle = to(p[mcp]);
+  V n = cross(sub(knuckle, to(p[lm::kWrist])), sub(to(p[mcp + 3]), knuckle));
+  const double n_len = std::sqrt(dot(n, n));
+  n = {n.x / n_len, n.y / n_len, n.z / n_len};
+  const double now = extract_features(hand, a, 1.0).finger_curl_deg[finger];
+  const double t = (curl_deg - now) * std::acos(-1.0) / 180;  // about n: the curl grows
+  for (std::size_t k = mcp + 1; k <= mcp + 3; ++k) {
+    const V v = sub(to(p[k]), knuckle);
+    const V c = cross(n, v);
+    const double along = dot(n, v) * (1 - std::cos(t));
+    const V r{v.x * std::cos(t) + c.x * std::sin(t) + n.x * along,
+              v.y * std::cos(t) + c.y * std::sin(t) + n.y * along,
+              v.z * std::cos(t) + c.z * std::sin(t) + n.z * along};
+    p[k] = {(knuckle.x + r.x) / a, knuckle.y + r.y, (knuckle.z + r.z) / a};
+  }
+  return hand;
+}
+
+// A finger is folded once its knuckle -> tip chord has turned past a right angle from the
+// palm's axis (finger_folded_min_curl_deg 90): the tracker reads real folded fingers at
+// 99-168 deg (MediaPipe's own victory sample: ring and little finger at 99 and 100 deg).
+// Short of 90 deg it is a half-closed finger, neither folded nor extended.
+TEST(RuleBasedRecognizer, AFingerTurnedPastARightAngleIsFolded) {
+  const RuleBasedRecognizer recognizer;
+  const RuleBasedOptions o;
+  ASSERT_EQ(o.finger_folded_min_curl_deg, 90);
+  std::mt19937 rng(34);
+  for (int i = 0; i < 10; ++i) {
+    const Landmarks point = place(upright(PoseName::kPointUp, rng));
+    ASSERT_EQ(recognizer.recognize(point).gesture, GestureType::kPointUp);
+    const Landmarks at95 = with_finger_curl(point, 1, 95);
+    ASSERT_NEAR(extract_features(at95, o.aspect_ratio, 1).finger_curl_deg[1], 95, 1e-6);
+    const Recognition r = recognizer.recognize(at95);
+    EXPECT_EQ(r.gesture, GestureType::kPointUp);
+    EXPECT_NEAR(r.confidence, 0.6, 1e-6);  // 5 deg past the limit: a third of the transition
+    EXPECT_EQ(recognizer.recognize(with_finger_curl(point, 1, 85)).gesture, GestureType::kNone);
+
+    const Landmarks victory = place(sim::pose_for(PoseName::kVictory, rng));
+    ASSERT_EQ(recognizer.recognize(victory).gesture, GestureType::kVictory);
+    const Landmarks loose = with_finger_curl(with_finger_curl(victory, 2, 99), 3, 100);
+    EXPECT_EQ(recognizer.recognize(loose).gesture, GestureType::kVictory);
+    EXPECT_EQ(recognizer.recognize(with_finger_curl(victory, 3, 80)).gesture, GestureType::kNone);
+
+    const Landmarks fist = place(sim::pose_for(PoseName::kFist, rng));
+    ASSERT_EQ(recognizer.recognize(fist).gesture, GestureType::kFist);
+    EXPECT_EQ(recognizer.recognize(with_finger_curl(with_finger_curl(fist, 0, 94), 1, 94)).gesture,
+              GestureType::kFist);
+    Landmarks half_closed = fist;
+    for (int f = 0; f < 4; ++f) half_closed = with_finger_curl(half_closed, f, 85);
+    EXPECT_EQ(recognizer.recognize(half_closed).gesture, GestureType::kNone);
+  }
+}
+
 // A thumb tucked beside the index or hidden behind the hand reads neither folded nor out; the
 // pointing and victory shapes need it only not out. Clearly out, it is the "L" (not a gesture).
 TEST(RuleBasedRecognizer, PointingAndVictoryNeedTheThumbOnlyNotOut) {

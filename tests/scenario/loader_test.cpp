@@ -57,7 +57,7 @@ TEST(ScenarioLoader, EverySuiteFileLoadsAndMatchesTheSchema) {
   // Kept out of ctest until issue 5 lands, but they must stay valid.
   const auto blocked =
       scenario_files(std::string(GBDCS_SOURCE_DIR) + "/scenarios/blocked_by_issue_5");
-  EXPECT_GE(blocked.size(), 2u);
+  EXPECT_GE(blocked.size(), 1u);
   files.insert(files.end(), blocked.begin(), blocked.end());
   for (const auto& f : files) {
     SCOPED_TRACE(f);

@@ -28,7 +28,7 @@
 // Options (JSON keys = field names; defaults below; unknown keys and wrong types rejected
 // with std::invalid_argument naming the key)
 //   aspect_ratio 4/3 (frame width / height), depth_weight 1 (trust in z, [0, 1]),
-//   finger_extended_max_curl_deg 35, finger_folded_min_curl_deg 100,
+//   finger_extended_max_curl_deg 35, finger_folded_min_curl_deg 90,
 //   thumb_extended_min_lateral 0.45 and thumb_folded_max_lateral 0.3 (palm sizes),
 //   thumb_extended_max_bend_deg 45, thumb_aimed_max_bend_deg 30 ([0, the extended limit];
 //   0 turns the aimed-thumb rule off), thumb_aimed_min_lateral 0 (below the extended limit),
@@ -49,7 +49,7 @@ struct RuleBasedOptions {
   double aspect_ratio = 4.0 / 3.0;
   double depth_weight = 1.0;
   double finger_extended_max_curl_deg = 35;
-  double finger_folded_min_curl_deg = 100;
+  double finger_folded_min_curl_deg = 90;
   double thumb_extended_min_lateral = 0.45;
   double thumb_folded_max_lateral = 0.3;
   double thumb_extended_max_bend_deg = 45;
