@@ -242,7 +242,9 @@ TEST(TrackerModels, SecondFrameTracksFromLandmarksWithoutDetection) {
 TEST(TrackerModels, LosingTheHandTriggersDetectionInTheSameFrame) {
   const DrawnHand hand = synthetic_hand();
   contracts::ManualClock clock;
-  HandTracker tracker(video_options(), clock);
+  TrackerOptions o = video_options();
+  o.coast_frames = 0;  // MediaPipe's behaviour: a lost hand is given up at once
+  HandTracker tracker(o, clock);
   ASSERT_EQ(tracker.process(hand.rgb).size(), 1u);
   EXPECT_TRUE(tracker.process(blank_frame()).empty());  // tracked ROI shows no hand
   EXPECT_TRUE(tracker.last_timings().ran_detection);
@@ -250,6 +252,50 @@ TEST(TrackerModels, LosingTheHandTriggersDetectionInTheSameFrame) {
   const auto back = tracker.process(hand.rgb);
   ASSERT_EQ(back.size(), 1u);
   EXPECT_TRUE(back[0].from_detection);
+}
+
+// A lost hand is still looked for where it was for coast_frames frames, never reported while
+// its presence is low; back within them it is tracked again without the detector, later it
+// has been given up and only detection finds it.
+TEST(TrackerModels, ALostHandIsLookedForWhereItWasForCoastFrames) {
+  const DrawnHand hand = synthetic_hand();
+  TickingClock clock;
+  TrackerOptions o = video_options();
+  o.coast_frames = 2;
+  HandTracker tracker(o, clock);
+  ASSERT_EQ(tracker.process(hand.rgb).size(), 1u);
+  for (int gone = 1; gone <= o.coast_frames; ++gone) {
+    EXPECT_TRUE(tracker.process(blank_frame()).empty()) << gone;
+    const TrackerTimings t = tracker.last_timings();
+    EXPECT_TRUE(t.ran_detection) << gone;       // nothing reported: detection runs as well
+    EXPECT_DOUBLE_EQ(t.landmarks_ms, 1.0) << gone;  // and one landmark run where it was
+  }
+  auto back = tracker.process(hand.rgb);
+  ASSERT_EQ(back.size(), 1u);
+  EXPECT_FALSE(back[0].from_detection);  // found where it was lost
+  EXPECT_GE(back[0].landmarks.score, 0.8);
+
+  // Gone for one frame more than coast_frames: given up, found again by detection only.
+  for (int gone = 1; gone <= o.coast_frames + 1; ++gone) {
+    EXPECT_TRUE(tracker.process(blank_frame()).empty());
+  }
+  EXPECT_DOUBLE_EQ(tracker.last_timings().landmarks_ms, 1.0);  // the last look
+  EXPECT_TRUE(tracker.process(blank_frame()).empty());
+  EXPECT_DOUBLE_EQ(tracker.last_timings().landmarks_ms, 0.0);  // nothing left to look for
+  back = tracker.process(hand.rgb);
+  ASSERT_EQ(back.size(), 1u);
+  EXPECT_TRUE(back[0].from_detection);
+
+  // reset() forgets lost hands too.
+  ASSERT_TRUE(tracker.process(blank_frame()).empty());
+  tracker.reset();
+  EXPECT_TRUE(tracker.process(blank_frame()).empty());
+  EXPECT_DOUBLE_EQ(tracker.last_timings().landmarks_ms, 0.0);
+
+  o.coast_frames = 31;
+  EXPECT_THROW((void)HandTracker(o, clock), std::invalid_argument);
+  o.coast_frames = -1;
+  EXPECT_THROW((void)HandTracker(o, clock), std::invalid_argument);
 }
 
 TEST(TrackerModels, StaticImagesDetectEveryFrame) {

@@ -26,6 +26,9 @@ const TrackerOptions& validated(const TrackerOptions& o) {
     fail("min_presence must be in [0, 1], got " + std::to_string(o.min_presence));
   }
   if (o.threads < 1) fail("threads must be >= 1, got " + std::to_string(o.threads));
+  if (o.coast_frames < 0 || o.coast_frames > 30) {
+    fail("coast_frames must be in [0, 30], got " + std::to_string(o.coast_frames));
+  }
   return o;
 }
 
@@ -52,6 +55,7 @@ double HandTracker::elapsed_ms(contracts::Duration since) const {
 
 void HandTracker::reset() {
   tracked_.clear();
+  coasting_.clear();
   timings_ = {};
 }
 
@@ -62,16 +66,27 @@ std::vector<HandObservation> HandTracker::process(const cv::Mat& rgb) {
   bool lost = false;
 
   if (!options_.static_images) {
-    for (const RotatedRect& roi : tracked_) {
+    // Lost hands first looked for where their last landmarks were, then the tracked ones.
+    std::vector<Coasting> still_lost;
+    auto look = [&](const RotatedRect& roi, int frames_left) {
       const contracts::Duration start = clock_.now();
       LandmarkResult r = landmarker_.run(rgb, roi);
       timings_.landmarks_ms += elapsed_ms(start);
       if (r.landmarks.score >= options_.min_presence) {
         hands.push_back({r.landmarks, roi, false});
-      } else {
-        lost = true;
+        return;
       }
+      if (frames_left > 0) {
+        still_lost.push_back({landmarks_to_roi(r.landmarks.points, rgb.cols, rgb.rows), frames_left});
+      }
+    };
+    for (const Coasting& c : coasting_) look(c.roi, c.frames_left - 1);
+    for (const RotatedRect& roi : tracked_) {
+      const std::size_t before = hands.size();
+      look(roi, options_.coast_frames);
+      if (hands.size() == before) lost = true;
     }
+    coasting_ = std::move(still_lost);
     // Two tracked ROIs that slid onto the same hand: keep the more confident one.
     std::vector<HandObservation> unique;
     for (HandObservation& h : hands) {
@@ -99,6 +114,14 @@ std::vector<HandObservation> HandTracker::process(const cv::Mat& rgb) {
     for (const HandObservation& h : hands) {
       tracked_.push_back(landmarks_to_roi(h.landmarks.points, rgb.cols, rgb.rows));
     }
+    // A lost hand found again (by detection or by tracking) is no longer looked for, and no
+    // more hands are looked for than max_hands.
+    std::erase_if(coasting_, [&](const Coasting& c) {
+      return std::any_of(tracked_.begin(), tracked_.end(),
+                         [&](const RotatedRect& t) { return rect_iou(t, c.roi) > kSameHandIou; });
+    });
+    const std::size_t room = static_cast<std::size_t>(options_.max_hands) - tracked_.size();
+    if (coasting_.size() > room) coasting_.resize(room);
   }
   return hands;
 }

@@ -22,6 +22,14 @@
 //          we do not, so that one tracked hand costs one landmark run a frame: with
 //          max_hands 2 and one hand tracked, a second hand entering the view is found once
 //          tracking of the first is lost (or after reset()).
+//          Coasting: a tracked hand whose presence falls below min_presence is not reported,
+//          but for up to coast_frames further frames the landmark model is still run where its
+//          landmarks put it (the ROI follows them, as in tracking); when the presence is back
+//          at min_presence or more the hand is reported again (from_detection false), and
+//          detection runs in every frame meanwhile as for a lost hand. So a hand the palm
+//          detector cannot find (a dark hand against clutter, seen from the back) is not lost
+//          for good by one or two frames of low presence in a transition. Nothing below
+//          min_presence is ever reported. coast_frames 0 is MediaPipe's behaviour.
 //          Overlap: a detected ROI whose axis-aligned IoU with an accepted hand's ROI is > 0.5
 //          is the same hand (AssociationNormRectCalculator's 0.5) and is skipped; two tracked
 //          hands whose next ROIs overlap by > 0.5 have converged on one hand: the one with the
@@ -30,7 +38,8 @@
 //          (else the lite pair); models come from model_dir (verified against their pinned
 //          SHA-256, model_files.hpp).
 // Errors   constructor: std::invalid_argument for bad options (max_hands < 1, a confidence
-//          outside [0, 1], threads < 1); ModelError for a missing, altered or unusable model.
+//          outside [0, 1], threads < 1, coast_frames outside [0, 30]); ModelError for a
+//          missing, altered or unusable model.
 //          process(): std::invalid_argument for an empty image or one that is not CV_8UC3.
 // Threads  one process() at a time; the clock must outlive the tracker.
 #pragma once
@@ -54,6 +63,7 @@ struct TrackerOptions {
   bool static_images = false;             // true: detect every frame, no tracking
   std::string model_dir;                  // empty = default_model_dir()
   int threads = 1;                        // inference threads per model
+  int coast_frames = 5;                   // frames a lost hand is still looked for (0 = none)
 };
 
 struct HandObservation {
@@ -85,7 +95,12 @@ class HandTracker {
   const contracts::Clock& clock_;
   PalmDetector detector_;
   HandLandmarker landmarker_;
+  struct Coasting {
+    RotatedRect roi;      // where the lost hand's last landmarks put it
+    int frames_left = 0;  // landmark runs left before it is given up
+  };
   std::vector<RotatedRect> tracked_;  // ROIs for the next frame, from this frame's landmarks
+  std::vector<Coasting> coasting_;    // lost hands still looked for (not reported)
   TrackerTimings timings_;
 };
 
