@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <random>
 #include <vector>
@@ -272,6 +273,20 @@ TEST(TrackerRoi, RectIouIgnoresRotation) {
   EXPECT_NEAR(rect_iou(a, b), 1.0, 1e-12);
   b.center_x = 0.6;
   EXPECT_NEAR(rect_iou(a, b), 0.1 * 0.2 / (0.08 - 0.02), 1e-12);
+}
+
+TEST(TrackerRoi, ACollapsedOrNonFiniteRoiIsNotUsable) {
+  EXPECT_TRUE(roi_is_usable({0.5, 0.5, 0.2, 0.2, 0.3}, 640, 480));
+  EXPECT_TRUE(roi_is_usable({0.5, 0.5, 8.0 / 640, 8.0 / 480, 0}, 640, 480));
+  EXPECT_FALSE(roi_is_usable({0.5, 0.5, 7.0 / 640, 0.2, 0}, 640, 480));
+  EXPECT_FALSE(roi_is_usable({0.5, 0.5, 0.2, 0, 0}, 640, 480));
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_FALSE(roi_is_usable({nan, 0.5, 0.2, 0.2, 0}, 640, 480));
+  EXPECT_FALSE(roi_is_usable({0.5, 0.5, 0.2, 0.2, nan}, 640, 480));
+  // Landmarks all at one point (a model that barely sees a hand) give no usable ROI.
+  std::array<contracts::Point3, contracts::kLandmarkCount> one_point{};
+  one_point.fill({0.4, 0.6, 0});
+  EXPECT_FALSE(roi_is_usable(landmarks_to_roi(one_point, 640, 480), 640, 480));
 }
 
 TEST(TrackerCrop, AffineRoundTripAndProjectionAgree) {

@@ -76,8 +76,9 @@ std::vector<HandObservation> HandTracker::process(const cv::Mat& rgb) {
         hands.push_back({r.landmarks, roi, false});
         return;
       }
-      if (frames_left > 0) {
-        still_lost.push_back({landmarks_to_roi(r.landmarks.points, rgb.cols, rgb.rows), frames_left});
+      const RotatedRect next = landmarks_to_roi(r.landmarks.points, rgb.cols, rgb.rows);
+      if (frames_left > 0 && roi_is_usable(next, rgb.cols, rgb.rows)) {
+        still_lost.push_back({next, frames_left});
       }
     };
     for (const Coasting& c : coasting_) look(c.roi, c.frames_left - 1);
@@ -112,7 +113,8 @@ std::vector<HandObservation> HandTracker::process(const cv::Mat& rgb) {
   tracked_.clear();
   if (!options_.static_images) {
     for (const HandObservation& h : hands) {
-      tracked_.push_back(landmarks_to_roi(h.landmarks.points, rgb.cols, rgb.rows));
+      const RotatedRect next = landmarks_to_roi(h.landmarks.points, rgb.cols, rgb.rows);
+      if (roi_is_usable(next, rgb.cols, rgb.rows)) tracked_.push_back(next);  // else: detect
     }
     // A lost hand found again (by detection or by tracking) is no longer looked for, and no
     // more hands are looked for than max_hands.

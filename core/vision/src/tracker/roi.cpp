@@ -338,6 +338,13 @@ double rect_iou(const RotatedRect& a, const RotatedRect& b) {
       {b.center_x - b.width / 2, b.center_y - b.height / 2, b.width, b.height});
 }
 
+bool roi_is_usable(const RotatedRect& roi, int image_width, int image_height) {
+  return std::isfinite(roi.center_x) && std::isfinite(roi.center_y) &&
+         std::isfinite(roi.rotation_rad) && std::isfinite(roi.width) &&
+         std::isfinite(roi.height) && roi.width * image_width >= kMinRoiPixels &&
+         roi.height * image_height >= kMinRoiPixels;
+}
+
 // ---- crop geometry --------------------------------------------------------------------
 Point2 apply(const Affine2D& m, const Point2& p) {
   return {m.a * p.x + m.b * p.y + m.c, m.d * p.x + m.e * p.y + m.f};

@@ -179,6 +179,12 @@ RotatedRect landmarks_to_roi(const std::array<contracts::Point3, contracts::kLan
 // IoU of the axis-aligned boxes of two rects, ignoring rotation (AssociationNormRectCalculator).
 double rect_iou(const RotatedRect& a, const RotatedRect& b);
 
+// Whether a ROI can be cropped: every field finite and at least kMinRoiPixels wide and high in
+// an image of that size. Landmarks of a hand the model barely sees can collapse, and a
+// degenerate ROI would make the next crop's transform singular.
+inline constexpr double kMinRoiPixels = 8;
+bool roi_is_usable(const RotatedRect& roi, int image_width, int image_height);
+
 // ---- crop geometry --------------------------------------------------------------------
 // x' = a x + b y + c, y' = d x + e y + f.
 struct Affine2D {
