@@ -67,6 +67,7 @@ std::vector<HandObservation> HandTracker::process(const cv::Mat& rgb) {
 
   if (!options_.static_images) {
     // Lost hands first looked for where their last landmarks were, then the tracked ones.
+    // A hand under min_presence is kept looking for while it has frames left.
     std::vector<Coasting> still_lost;
     auto look = [&](const RotatedRect& roi, int frames_left) {
       const contracts::Duration start = clock_.now();
@@ -74,18 +75,17 @@ std::vector<HandObservation> HandTracker::process(const cv::Mat& rgb) {
       timings_.landmarks_ms += elapsed_ms(start);
       if (r.landmarks.score >= options_.min_presence) {
         hands.push_back({r.landmarks, roi, false});
-        return;
+        return true;
       }
-      const RotatedRect next = landmarks_to_roi(r.landmarks.points, rgb.cols, rgb.rows);
-      if (frames_left > 0 && roi_is_usable(next, rgb.cols, rgb.rows)) {
-        still_lost.push_back({next, frames_left});
+      if (frames_left > 0) {
+        const RotatedRect next = landmarks_to_roi(r.landmarks.points, rgb.cols, rgb.rows);
+        if (roi_is_usable(next, rgb.cols, rgb.rows)) still_lost.push_back({next, frames_left});
       }
+      return false;
     };
     for (const Coasting& c : coasting_) look(c.roi, c.frames_left - 1);
     for (const RotatedRect& roi : tracked_) {
-      const std::size_t before = hands.size();
-      look(roi, options_.coast_frames);
-      if (hands.size() == before) lost = true;
+      if (!look(roi, options_.coast_frames)) lost = true;
     }
     coasting_ = std::move(still_lost);
     // Two tracked ROIs that slid onto the same hand: keep the more confident one.
