@@ -232,6 +232,32 @@ TEST(RuleBasedRecognizer, PointingAndVictoryNeedTheThumbOnlyNotOut) {
   }
 }
 
+// "Not out" is judged against the extended limit: the further in the thumb lies, the surer
+// the pointing and the victory, across the folded limit too (a thumb just inside it must not
+// read less sure than one just outside).
+TEST(RuleBasedRecognizer, AThumbFurtherInNeverLowersPointingConfidence) {
+  const RuleBasedRecognizer recognizer;
+  const RuleBasedOptions o;
+  std::mt19937 rng(47);
+  for (int i = 0; i < 5; ++i) {
+    const Landmarks point = with_straight_thumb(place(upright(PoseName::kPointUp, rng)));
+    const Landmarks victory = with_straight_thumb(place(sim::pose_for(PoseName::kVictory, rng)));
+    for (const auto& [hand, gesture] :
+         {std::pair{point, GestureType::kPointUp}, std::pair{victory, GestureType::kVictory}}) {
+      double before = 0;
+      for (double lateral = o.thumb_extended_min_lateral - 0.01; lateral > -0.3; lateral -= 0.02) {
+        const Recognition r = recognizer.recognize(with_thumb_at(hand, lateral));
+        ASSERT_EQ(r.gesture, gesture) << "thumb at " << lateral;
+        EXPECT_GE(r.confidence, before - 1e-9) << "thumb at " << lateral;
+        before = r.confidence;
+      }
+      // Just inside the folded limit: as sure as halfway between the limits, or surer.
+      const double inside = recognizer.recognize(with_thumb_at(hand, o.thumb_folded_max_lateral - 0.01)).confidence;
+      EXPECT_GE(inside, recognizer.recognize(with_thumb_at(hand, between_the_limits(o))).confidence);
+    }
+  }
+}
+
 // Seen end-on, a raised thumb's tip is placed over the folded fingers by the tracker: a
 // straight thumb aimed up or down over four folded fingers is the thumb gesture, unless its
 // tip lies past the palm's middle (a thumb across a fist) or it points sideways.

@@ -266,6 +266,27 @@ TEST(TrackerRoi, LandmarksToRectUsesThePalmSubsetAndTheHandsRotation) {
   EXPECT_NEAR(next.center_y * 480, 340 - 12, 1e-9);  // shift_y -0.1 of 120 px, upward
 }
 
+// MediaPipe's HandLandmarksToRectCalculator names its joints "PIP", but its indices 4, 6, 8
+// count within the 12-landmark subset, where they are the index, middle and ring MCPs: the
+// ROI turns with the palm, not with the fingers. Folding the fingers 90 degrees to the side
+// (their PIPs far off the wrist -> knuckle axis) must not turn it.
+TEST(TrackerRoi, LandmarksToRectTurnsWithTheKnucklesNotTheFoldedFingers) {
+  Pts hand = upright_hand();
+  for (int f = 1; f < 5; ++f) {  // index .. pinky: PIP, DIP, tip 30 px apart, to the right
+    const contracts::Point3 mcp = hand[1 + 4 * f];
+    for (int j = 1; j < 4; ++j) {
+      hand[1 + 4 * f + j] = {mcp.x + 30.0 * j / 640, mcp.y, 0};
+    }
+  }
+  const RotatedRect r = landmarks_to_rect(hand, 640, 480);
+  // Wrist (320, 400) to ((290 + 350) / 2 + 320) / 2 = 320, y 340: straight up.
+  EXPECT_NEAR(r.rotation_rad, 0, 1e-9);
+
+  const double angle = -50 * kPi / 180;
+  const RotatedRect t = landmarks_to_rect(rotate_about(hand, 320, 370, angle), 640, 480);
+  EXPECT_NEAR(t.rotation_rad, angle, 1e-9);
+}
+
 TEST(TrackerRoi, RectIouIgnoresRotation) {
   RotatedRect a{0.5, 0.5, 0.2, 0.2, 0};
   RotatedRect b = a;

@@ -184,14 +184,14 @@ Recognition RuleBasedRecognizer::recognize(const contracts::Landmarks& hand) con
     if (!c || digits[0].state != thumb) return std::nullopt;
     return std::min(*c, digits[0].confidence);
   };
-  // For pointing and victory the thumb only has to be not out: a thumb read unclear (tucked
-  // beside the index, or hidden behind the hand) counts, with the margin by which it misses
-  // "extended" as its confidence.
+  // For pointing and victory the thumb only has to be not out: folded, or read unclear
+  // (tucked beside the index, or hidden behind the hand). Its confidence is the margin by which
+  // it misses "extended", so a thumb further in is never less sure (the folded limit plays no
+  // part here).
   auto shape_thumb_in = [&](std::array<Digit, 4> want) -> std::optional<double> {
     const auto c = fingers(want);
     if (!c || digits[0].state == kE) return std::nullopt;
-    return std::min(*c, digits[0].state == kF ? digits[0].confidence
-                                              : margin_confidence(-digits[0].extended));
+    return std::min(*c, margin_confidence(-digits[0].extended));
   };
   auto scaled = [presence](Recognition r) {
     r.confidence *= presence;

@@ -282,10 +282,12 @@ RotatedRect landmarks_to_rect(const std::array<contracts::Point3, contracts::kLa
       kWrist,     kThumbCmc,  kThumbMcp, kThumbIp, kIndexMcp, kIndexPip,
       kMiddleMcp, kMiddlePip, kRingMcp,  kRingPip, kPinkyMcp, kPinkyPip};
   const Point2 wrist{pts[kWrist].x, pts[kWrist].y};
-  const Point2 pip_mean{((pts[kIndexPip].x + pts[kRingPip].x) / 2 + pts[kMiddlePip].x) / 2,
-                        ((pts[kIndexPip].y + pts[kRingPip].y) / 2 + pts[kMiddlePip].y) / 2};
+  // MediaPipe's kIndexFingerPIPJoint 4, kMiddleFingerPIPJoint 6, kRingFingerPIPJoint 8 index
+  // the subset above: the index, middle and ring MCPs. The ROI turns with the palm.
+  const Point2 mcp_mean{((pts[kIndexMcp].x + pts[kRingMcp].x) / 2 + pts[kMiddleMcp].x) / 2,
+                        ((pts[kIndexMcp].y + pts[kRingMcp].y) / 2 + pts[kMiddleMcp].y) / 2};
   const double rotation =
-      rotation_to_target(wrist, pip_mean, image_width, image_height, std::numbers::pi / 2);
+      rotation_to_target(wrist, mcp_mean, image_width, image_height, std::numbers::pi / 2);
   const double reverse = normalize_radians(-rotation);
 
   double min_x = std::numeric_limits<double>::max(), max_x = std::numeric_limits<double>::lowest();

@@ -8,8 +8,8 @@
 //            THUMB_UP    thumb only, pointing up    THUMB_DOWN  thumb only, pointing down
 //            POINT_LEFT / POINT_RIGHT / POINT_UP    index only, pointing that way in the image
 //            VICTORY     index + middle, spread     I_LOVE_YOU  thumb + index + pinky
-//          Pointing and victory need the thumb only not extended (an unclear thumb counts,
-//          with the margin by which it misses "extended" as its confidence). Four folded
+//          Pointing and victory need the thumb only not extended (folded or unclear; its
+//          confidence is the margin by which it misses "extended"). Four folded
 //          fingers with a straight thumb (bend <= thumb_aimed_max_bend_deg) aimed up or down,
 //          its tip at least thumb_aimed_min_lateral toward the index side, read as the thumb
 //          gesture even when the tip's lateral position says folded (a raised thumb seen

@@ -167,8 +167,9 @@ RotatedRect detection_to_rect(const PalmDetection& d, int image_width, int image
 RotatedRect palm_detection_to_roi(const PalmDetection& d, int image_width, int image_height);
 
 // HandLandmarksToRectCalculator on landmarks {0,1,2,3,5,6,9,10,13,14,17,18}: rotation from the
-// wrist to the mean of ((index PIP + ring PIP) / 2, middle PIP), target 90°; the box of those
-// landmarks in the rotated frame.
+// wrist to the mean of ((index MCP + ring MCP) / 2, middle MCP), target 90°; the box of those
+// landmarks in the rotated frame. (The calculator calls these joints "PIP", but its indices 4,
+// 6 and 8 count within that 12-landmark subset, where they are the three MCPs.)
 RotatedRect landmarks_to_rect(const std::array<contracts::Point3, contracts::kLandmarkCount>& pts,
                               int image_width, int image_height);
 // landmarks_to_rect then RectTransformation {scale 2.0, shift_y -0.1, square_long}: the ROI
