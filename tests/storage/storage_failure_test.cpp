@@ -98,6 +98,41 @@ TEST(StorageWriteFailure, AnUnknownSessionIsAReportedConstraintFailure) {
   EXPECT_EQ(calls, 1);
 }
 
+// On a nearly full disk a write that reuses freed space succeeds between failing ones; the
+// episode (and the operator's alert) must not flap with it. It ends once writes have
+// succeeded for kWriteRecoveryHold with no failure between.
+TEST(StorageWriteFailure, AFailingEpisodeEndsOnlyAfterWritesSucceedForTheHold) {
+  TempDir dir;
+  ManualClock clock;
+  StorageManager db({.path = dir.file("gbdcs.db")}, clock);
+  const auto session = db.begin_session(std::nullopt, "twin", "default");
+  ASSERT_TRUE(db.write_health().ok);
+  int frame = 0;
+  const auto write_ok = [&] { return bool(db.log_telemetry(session, sample_frame(clock.utc_now(), frame++))); };
+  const auto write_fails = [&] { return !db.log_alert(4242, contracts::Alert{}); };
+
+  ASSERT_TRUE(write_fails());
+  EXPECT_FALSE(db.write_health().ok);
+  ASSERT_TRUE(write_ok());
+  EXPECT_FALSE(db.write_health().ok) << "one success does not end the episode";
+  clock.advance(kWriteRecoveryHold / 2);
+  ASSERT_TRUE(write_fails());
+  clock.advance(kWriteRecoveryHold / 2);
+  ASSERT_TRUE(write_ok());
+  EXPECT_FALSE(db.write_health().ok) << "the failure between restarted the hold";
+  EXPECT_EQ(db.write_health().episodes, 1);
+  EXPECT_EQ(db.write_health().episode_failures, 2);
+
+  clock.advance(kWriteRecoveryHold);
+  ASSERT_TRUE(write_ok());
+  EXPECT_TRUE(db.write_health().ok) << "writes succeeded for the hold";
+  EXPECT_EQ(db.write_health().episodes, 1);
+  EXPECT_EQ(db.telemetry(session).size(), 3u);
+
+  ASSERT_TRUE(write_fails());
+  EXPECT_EQ(db.write_health().episodes, 2) << "a later failure starts a new episode";
+}
+
 TEST(StorageWriteFailure, AHandlerThatWritesAndFailsAgainDoesNotRecurse) {
   TempDir dir;
   ManualClock clock;

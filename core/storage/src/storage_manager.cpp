@@ -162,7 +162,13 @@ void StorageManager::checked_write(std::string_view what, const std::function<vo
 
 void StorageManager::note_write_ok() {
   std::lock_guard lock(health_mutex_);
-  health_.ok = true;
+  if (health_.ok) return;
+  const contracts::Duration now = clock_.now();
+  if (!first_ok_) first_ok_ = now;
+  if (now - *first_ok_ >= kWriteRecoveryHold) {
+    health_.ok = true;
+    first_ok_.reset();
+  }
 }
 
 WriteHealth StorageManager::write_health() const {
@@ -185,6 +191,7 @@ void StorageManager::report_failure(const std::string& message, const std::strin
     }
     ++health_.failures;
     ++health_.episode_failures;
+    first_ok_.reset();
   }
   // A handler that logs to this store and fails again must not recurse without end.
   thread_local bool in_handler = false;

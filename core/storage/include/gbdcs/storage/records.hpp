@@ -2,10 +2,12 @@
 // Times are contracts::UtcTime (milliseconds since the Unix epoch, UTC), as stored.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <optional>
 #include <string>
 
+#include "gbdcs/contracts/clock.hpp"
 #include "gbdcs/contracts/messages.hpp"
 
 namespace gbdcs::storage {
@@ -55,9 +57,12 @@ struct AlertRecord {
 };
 
 // Whether writes currently succeed, for health checks and alerts. A failing episode starts
-// with the first failed write and ends with the next write that succeeds.
+// with the first failed write and ends once writes have succeeded for kWriteRecoveryHold
+// (2 s) with no failure between.
+inline constexpr contracts::Duration kWriteRecoveryHold = std::chrono::seconds(2);
+
 struct WriteHealth {
-  bool ok = true;               // the last write succeeded (or none was tried)
+  bool ok = true;               // no failing episode (none yet, or the last one has ended)
   bool disk_full = false;       // the failing writes ran out of space (ENOSPC, EFBIG, SQLITE_FULL)
   std::string error;            // the first failure of the current (or last) episode
   std::string suggestion;       // the fix for that failure, for an operator

@@ -17,6 +17,9 @@
 //           (and a failed write among them is counted and reported the same way).
 //           A full disk (ENOSPC, a file-size limit's EFBIG, SQLITE_FULL) is named as such,
 //           with the fix "free disk space"; write_health() tells whether writes fail now.
+//           A failing episode ends once writes have succeeded for kWriteRecoveryHold (injected
+//           clock) with no failure between: a nearly full disk, where a write that reuses
+//           freed space succeeds between failing ones, stays one episode instead of flapping.
 // Durability: WAL, synchronous=FULL, every write commits on its own: a kill -9 loses nothing
 //           that a call already returned as ok.
 // Threads:  every method may be called from any thread; one mutex serialises the connection.
@@ -141,8 +144,9 @@ class StorageManager {
   std::unique_ptr<detail::Connection> db_;
   int schema_version_ = 0;
   std::atomic<std::int64_t> write_failures_{0};
-  mutable std::mutex health_mutex_;  // guards health_
+  mutable std::mutex health_mutex_;  // guards health_ and first_ok_
   WriteHealth health_;
+  std::optional<contracts::Duration> first_ok_;  // first success since the episode's last failure
   std::mutex handler_mutex_;
   std::function<void(const std::string&)> error_handler_;
 };
