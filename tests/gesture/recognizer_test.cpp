@@ -252,8 +252,11 @@ TEST(RuleBasedRecognizer, AThumbFurtherInNeverLowersPointingConfidence) {
         before = r.confidence;
       }
       // Just inside the folded limit: as sure as halfway between the limits, or surer.
-      const double inside = recognizer.recognize(with_thumb_at(hand, o.thumb_folded_max_lateral - 0.01)).confidence;
-      EXPECT_GE(inside, recognizer.recognize(with_thumb_at(hand, between_the_limits(o))).confidence);
+      const double inside =
+          recognizer.recognize(with_thumb_at(hand, o.thumb_folded_max_lateral - 0.01)).confidence;
+      const double between =
+          recognizer.recognize(with_thumb_at(hand, between_the_limits(o))).confidence;
+      EXPECT_GE(inside, between);
     }
   }
 }

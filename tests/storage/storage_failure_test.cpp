@@ -108,7 +108,9 @@ TEST(StorageWriteFailure, AFailingEpisodeEndsOnlyAfterWritesSucceedForTheHold) {
   const auto session = db.begin_session(std::nullopt, "twin", "default");
   ASSERT_TRUE(db.write_health().ok);
   int frame = 0;
-  const auto write_ok = [&] { return bool(db.log_telemetry(session, sample_frame(clock.utc_now(), frame++))); };
+  const auto write_ok = [&] {
+    return bool(db.log_telemetry(session, sample_frame(clock.utc_now(), frame++)));
+  };
   const auto write_fails = [&] { return !db.log_alert(4242, contracts::Alert{}); };
 
   ASSERT_TRUE(write_fails());
