@@ -178,6 +178,7 @@ Tally eval_fixture(const fs::path& dir, vision::HandFinder& finder,
                                                      true_hand->points[k], rgb.cols, rgb.rows) /
                                          std::max(1.0, size);
           }
+          t.offsets.add(*true_hand, match->landmarks, rgb.cols, rgb.rows, std::max(1.0, size));
         }
       }
     } else if (l.value("hand_present", false)) {

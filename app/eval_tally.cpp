@@ -1,5 +1,6 @@
 #include "eval_tally.hpp"
 
+#include <cmath>
 #include <iomanip>
 #include <iostream>
 #include <optional>
@@ -52,8 +53,16 @@ json summary_json(const Tally& t) {
     by_point.push_back(t.landmark_error_count > 0
                            ? json(v / static_cast<double>(t.landmark_error_count))
                            : json(nullptr));
+  json offset_by_point = nullptr;
+  if (const auto mean = t.offsets.mean_offsets()) {
+    offset_by_point = json::array();
+    for (const auto& m : *mean) offset_by_point.push_back({m.along_pct, m.across_pct});
+  }
+  const auto without_offsets = t.offsets.error_pct_without_offsets();
   return {{"accuracy", opt(ratio(t.correct(), t.scored()))},
           {"landmark_error_pct_by_point", by_point},
+          {"landmark_offset_pct_by_point", offset_by_point},
+          {"landmark_error_pct_mean_without_offsets", opt(without_offsets)},
           {"deliberate_accuracy", opt(ratio(t.reads.deliberate_correct, t.reads.deliberate_scored))},
           {"false_positive_rate", opt(ratio(t.reads.false_positives, t.reads.non_deliberate_scored))},
           {"detection_rate", opt(ratio(t.detected_frames, t.visible_frames))},
@@ -100,6 +109,24 @@ void print_summary(const std::string& title, const json& s) {
     std::cout << std::fixed << std::setprecision(2) << s["landmark_error_pct_mean"].get<double>()
               << " % of hand size mean, " << s["landmark_error_pct_max"].get<double>()
               << " % worst\n";
+    if (!s["landmark_error_pct_mean_without_offsets"].is_null()) {
+      // The landmark shifted furthest on average, and the error the scatter alone makes.
+      std::size_t far = 0;
+      double far_pct = -1;
+      const auto& by_point = s["landmark_offset_pct_by_point"];
+      for (std::size_t k = 0; k < by_point.size(); ++k) {
+        const double d = std::hypot(by_point[k][0].get<double>(), by_point[k][1].get<double>());
+        if (d > far_pct) {
+          far = k;
+          far_pct = d;
+        }
+      }
+      std::cout << "    without offsets   " << std::setprecision(2)
+                << s["landmark_error_pct_mean_without_offsets"].get<double>()
+                << " % (each landmark's mean shift taken away; the largest, landmark " << far
+                << ", " << by_point[far][0].get<double>() << " % along its bone, "
+                << by_point[far][1].get<double>() << " % across)\n";
+    }
   }
   std::cout << "  accuracy            " << fmt_pct(s["accuracy"]) << " of " << s["frames_scored"]
             << " frames\n"

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "gbdcs/contracts/messages.hpp"
+#include "gbdcs/sim/landmark_offsets.hpp"
 
 namespace gbdcs::app {
 
@@ -52,6 +53,9 @@ struct Tally {
   std::int64_t landmark_error_count = 0;
   double landmark_error_max_pct = 0;
   std::array<double, contracts::kLandmarkCount> point_error_sum_pct{};
+  // The same landmarks in their bones' axes: how much of the error is a shift every frame
+  // shares (a labelling convention, or the model's bias on the picture) and how much scatter.
+  sim::LandmarkOffsets offsets;
   std::array<std::array<std::int64_t, kClasses>, kClasses> confusion{};  // [true][predicted]
   // Scored frames per shown pose (rendered fixtures: FIST, RELAXED, ...; "NO_HAND"), by the
   // gesture read: which poses the recogniser confuses, not only which gestures.
@@ -69,6 +73,7 @@ struct Tally {
     landmark_error_max_pct = std::max(landmark_error_max_pct, o.landmark_error_max_pct);
     for (std::size_t i = 0; i < contracts::kLandmarkCount; ++i)
       point_error_sum_pct[i] += o.point_error_sum_pct[i];
+    offsets.add(o.offsets);
     for (std::size_t t = 0; t < kClasses; ++t)
       for (std::size_t p = 0; p < kClasses; ++p) confusion[t][p] += o.confusion[t][p];
   }
