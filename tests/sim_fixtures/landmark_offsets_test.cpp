@@ -35,16 +35,9 @@ std::vector<Landmarks> hands() {
   return out;
 }
 
-double size_px(const Landmarks& h) {
-  double x0 = 1e9, y0 = 1e9, x1 = -1e9, y1 = -1e9;
-  for (const auto& p : h.points) {
-    x0 = std::min(x0, p.x * kWidth);
-    x1 = std::max(x1, p.x * kWidth);
-    y0 = std::min(y0, p.y * kHeight);
-    y1 = std::max(y1, p.y * kHeight);
-  }
-  return std::hypot(x1 - x0, y1 - y0);
-}
+// The hand's size in pixels, as eval passes it (the accumulator takes any positive size; the
+// offsets are in % of it).
+constexpr double kSizePx = 150.0;
 
 // The tracker of this test: every landmark moved by `along` and `across` (% of the hand's
 // size) in its bone's axes as the contract defines them.
@@ -60,7 +53,6 @@ Landmarks shifted(const Landmarks& truth, double along, double across) {
   const auto w = px(kWrist), m = px(kMiddleMcp), i = px(kIndexMcp), l = px(kPinkyMcp);
   const auto palm = unit(m[0] - w[0], m[1] - w[1]);
   const double side = (-palm[1] * (i[0] - l[0]) + palm[0] * (i[1] - l[1])) >= 0 ? 1 : -1;
-  const double size = size_px(truth);
   Landmarks out = truth;
   for (std::size_t k = 0; k < kLandmarkCount; ++k) {
     const bool from_wrist =
@@ -69,8 +61,8 @@ Landmarks shifted(const Landmarks& truth, double along, double across) {
                    : from_wrist ? unit(px(k)[0] - w[0], px(k)[1] - w[1])
                                 : unit(px(k)[0] - px(k - 1)[0], px(k)[1] - px(k - 1)[1]);
     const std::array<double, 2> c{-a[1] * side, a[0] * side};
-    out.points[k].x += (along * a[0] + across * c[0]) * size / 100 / kWidth;
-    out.points[k].y += (along * a[1] + across * c[1]) * size / 100 / kHeight;
+    out.points[k].x += (along * a[0] + across * c[0]) * kSizePx / 100 / kWidth;
+    out.points[k].y += (along * a[1] + across * c[1]) * kSizePx / 100 / kHeight;
   }
   return out;
 }
@@ -79,7 +71,7 @@ TEST(LandmarkOffsets, AShiftAlongEachBoneIsFoundAtEveryTurnOfEitherHandAndTakenA
   // Measured in image axes, these shifts would cancel out over the turns and the two hands.
   LandmarkOffsets offsets;
   for (const auto& truth : hands())
-    offsets.add(truth, shifted(truth, -4.0, 1.5), kWidth, kHeight, size_px(truth));
+    offsets.add(truth, shifted(truth, -4.0, 1.5), kWidth, kHeight, kSizePx);
   const auto mean = offsets.mean_offsets();
   ASSERT_TRUE(mean.has_value());
   for (std::size_t k = 0; k < contracts::kLandmarkCount; ++k) {
@@ -103,8 +95,8 @@ TEST(LandmarkOffsets, ScatterAroundTheTruthStaysInTheError) {
       minus.points[k].x -= dx;
       minus.points[k].y -= dy;
     }
-    offsets.add(truth, plus, kWidth, kHeight, size_px(truth));
-    offsets.add(truth, minus, kWidth, kHeight, size_px(truth));
+    offsets.add(truth, plus, kWidth, kHeight, kSizePx);
+    offsets.add(truth, minus, kWidth, kHeight, kSizePx);
   }
   const auto mean = offsets.mean_offsets();
   ASSERT_TRUE(mean.has_value());
@@ -121,8 +113,8 @@ TEST(LandmarkOffsets, TalliesMergeAsOne) {
   LandmarkOffsets one, first, second;
   for (std::size_t i = 0; i < all.size(); ++i) {
     const Landmarks tracked = shifted(all[i], i % 2 == 0 ? -3.0 : 1.0, 0.5);
-    one.add(all[i], tracked, kWidth, kHeight, size_px(all[i]));
-    (i < all.size() / 3 ? first : second).add(all[i], tracked, kWidth, kHeight, size_px(all[i]));
+    one.add(all[i], tracked, kWidth, kHeight, kSizePx);
+    (i < all.size() / 3 ? first : second).add(all[i], tracked, kWidth, kHeight, kSizePx);
   }
   first.add(second);
   EXPECT_EQ(first.hands(), one.hands());
