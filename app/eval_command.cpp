@@ -169,15 +169,7 @@ Tally eval_fixture(const fs::path& dir, vision::HandFinder& finder,
         if (match != nullptr) {
           ++t.detected_frames;
           const double pct = 100.0 * match_px / std::max(1.0, size);
-          t.landmark_error_sum_pct += pct;
-          ++t.landmark_error_count;
           t.landmark_error_max_pct = std::max(t.landmark_error_max_pct, pct);
-          for (std::size_t k = 0; k < contracts::kLandmarkCount; ++k) {
-            t.point_error_sum_pct[k] += 100.0 *
-                                         distance_px(match->landmarks.points[k],
-                                                     true_hand->points[k], rgb.cols, rgb.rows) /
-                                         std::max(1.0, size);
-          }
           t.offsets.add(*true_hand, match->landmarks, rgb.cols, rgb.rows, std::max(1.0, size));
         }
       }

@@ -49,10 +49,11 @@ json summary_json(const Tally& t) {
     matrix.push_back(t.confusion[c]);
   }
   json by_point = json::array();
-  for (double v : t.point_error_sum_pct)
-    by_point.push_back(t.landmark_error_count > 0
-                           ? json(v / static_cast<double>(t.landmark_error_count))
-                           : json(nullptr));
+  if (const auto errors = t.offsets.error_pct_by_point()) {
+    for (double v : *errors) by_point.push_back(v);
+  } else {
+    by_point = json(std::vector<json>(contracts::kLandmarkCount, nullptr));
+  }
   json offset_by_point = nullptr;
   if (const auto mean = t.offsets.mean_offsets()) {
     offset_by_point = json::array();
@@ -70,12 +71,9 @@ json summary_json(const Tally& t) {
            opt(ratio(t.truth_reads.deliberate_correct, t.truth_reads.deliberate_scored))},
           {"truth_false_positive_rate",
            opt(ratio(t.truth_reads.false_positives, t.truth_reads.non_deliberate_scored))},
-          {"landmark_error_pct_mean",
-           t.landmark_error_count > 0
-               ? json(t.landmark_error_sum_pct / static_cast<double>(t.landmark_error_count))
-               : json(nullptr)},
+          {"landmark_error_pct_mean", opt(t.offsets.error_pct())},
           {"landmark_error_pct_max",
-           t.landmark_error_count > 0 ? json(t.landmark_error_max_pct) : json(nullptr)},
+           t.offsets.hands() > 0 ? json(t.landmark_error_max_pct) : json(nullptr)},
           {"frames_scored", t.scored()},
           {"deliberate_frames", t.reads.deliberate_scored},
           {"non_deliberate_frames", t.reads.non_deliberate_scored},

@@ -49,12 +49,10 @@ struct Tally {
   // The recogniser on the true landmarks of the same scored frames (rendered fixtures): what
   // the tracker could reach at best; below 1 means the pose or its label is at fault.
   Reads truth_reads;
-  double landmark_error_sum_pct = 0;
-  std::int64_t landmark_error_count = 0;
-  double landmark_error_max_pct = 0;
-  std::array<double, contracts::kLandmarkCount> point_error_sum_pct{};
-  // The same landmarks in their bones' axes: how much of the error is a shift every frame
-  // shares (a labelling convention, or the model's bias on the picture) and how much scatter.
+  double landmark_error_max_pct = 0;  // the worst matched hand's mean landmark error
+  // Every matched hand's landmarks against the truth, in their bones' axes: the landmark error
+  // (mean, per landmark) and how much of it is a shift every frame shares (a labelling
+  // convention, or the model's bias on the picture) and how much scatter.
   sim::LandmarkOffsets offsets;
   std::array<std::array<std::int64_t, kClasses>, kClasses> confusion{};  // [true][predicted]
   // Scored frames per shown pose (rendered fixtures: FIST, RELAXED, ...; "NO_HAND"), by the
@@ -68,11 +66,7 @@ struct Tally {
     detected_frames += o.detected_frames;
     reads.add(o.reads);
     truth_reads.add(o.truth_reads);
-    landmark_error_sum_pct += o.landmark_error_sum_pct;
-    landmark_error_count += o.landmark_error_count;
     landmark_error_max_pct = std::max(landmark_error_max_pct, o.landmark_error_max_pct);
-    for (std::size_t i = 0; i < contracts::kLandmarkCount; ++i)
-      point_error_sum_pct[i] += o.point_error_sum_pct[i];
     offsets.add(o.offsets);
     for (std::size_t t = 0; t < kClasses; ++t)
       for (std::size_t p = 0; p < kClasses; ++p) confusion[t][p] += o.confusion[t][p];

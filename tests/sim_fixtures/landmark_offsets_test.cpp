@@ -82,6 +82,17 @@ TEST(LandmarkOffsets, AShiftAlongEachBoneIsFoundAtEveryTurnOfEitherHandAndTakenA
   EXPECT_NEAR(*offsets.error_pct_without_offsets(), 0.0, 1e-6);
 }
 
+TEST(LandmarkOffsets, EachLandmarksErrorIsItsMeanDistance) {
+  LandmarkOffsets offsets;
+  for (const auto& truth : hands())
+    offsets.add(truth, shifted(truth, 3.0, -4.0), kWidth, kHeight, kSizePx);
+  const auto by_point = offsets.error_pct_by_point();
+  ASSERT_TRUE(by_point.has_value());
+  for (std::size_t k = 0; k < contracts::kLandmarkCount; ++k)
+    EXPECT_NEAR((*by_point)[k], 5.0, 1e-6) << "landmark " << k;
+  EXPECT_FALSE(LandmarkOffsets().error_pct_by_point().has_value());
+}
+
 TEST(LandmarkOffsets, ScatterAroundTheTruthStaysInTheError) {
   LandmarkOffsets offsets;
   std::mt19937 rng(11);
