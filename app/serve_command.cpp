@@ -10,6 +10,8 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <mutex>
+#include <optional>
 #include <sstream>
 #include <thread>
 
@@ -185,7 +187,17 @@ int run_serve(ServeOptions o) {
 
   std::unique_ptr<server::WorkerSupervisor> supervisor;
   std::atomic<double> fps{0};
-  std::atomic<bool> pipeline_healthy{true};
+  // What the drone service was last told of vision. A heartbeat passes on a change of it: of
+  // health (both ways), or of the reason while unhealthy (the camera's preparation counts its
+  // frames). Told under the lock, so a worker's loss and a heartbeat cannot cross.
+  std::mutex vision_told_mutex;
+  std::optional<std::pair<bool, std::string>> vision_told;
+  auto tell_vision = [&](bool healthy, const std::string& reason) {
+    std::lock_guard lock(vision_told_mutex);
+    if (vision_told && vision_told->first == healthy && vision_told->second == reason) return;
+    vision_told.emplace(healthy, reason);
+    drone.on_vision_health(healthy, reason);
+  };
   if (!o.no_worker) {
     server::WorkerOptions wo;
     wo.argv = {std::filesystem::read_symlink("/proc/self/exe").string(), "vision", "--source",
@@ -197,7 +209,7 @@ int run_serve(ServeOptions o) {
         clock, wo,
         [&](const std::string& why) {
           // HOVER first (the failsafe does it on unhealthy vision while flying), then the alert.
-          drone.on_vision_health(false, why);
+          tell_vision(false, why);
           contracts::Alert a;
           a.severity = contracts::Severity::kCritical;
           a.code = "VISION_WORKER_LOST";
@@ -207,18 +219,16 @@ int run_serve(ServeOptions o) {
           drone.raise_alert(a);
           http.metrics().worker_restarts++;
         },
-        [&] { drone.on_vision_health(true, ""); }, log);
+        [&] { tell_vision(true, ""); }, log);
     http.set_worker_handlers(
         {[&] { supervisor->on_connected(); },
          [&](const json& msg) {
            supervisor->on_message();
            if (msg["type"] == "heartbeat") {
              fps = msg.value("fps", 0.0);
-             // The pipeline's own verdict, passed on when it changes (both ways).
+             // The pipeline's own verdict.
              const bool healthy = msg.value("healthy", true);
-             if (healthy != pipeline_healthy.exchange(healthy)) {
-               drone.on_vision_health(healthy, healthy ? "" : msg.value("reason", ""));
-             }
+             tell_vision(healthy, healthy ? "" : msg.value("reason", ""));
              return;
            }
            if (msg["type"] == "picture") {

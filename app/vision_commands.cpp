@@ -91,13 +91,10 @@ int run_vision(const VisionOptions& o) {
   auto preparing = [&](std::int64_t done, std::int64_t total) {
     if (clock.now() - last_note < contracts::from_seconds(o.heartbeat_s) && done < total) return;
     last_note = clock.now();
-    vision::PipelineMetrics m;
-    m.healthy = false;
-    m.live = true;
-    m.source = o.source;
-    m.reason = "preparing the camera: rendering its video once into " +
-               fixture_cache_dir().string() + " (" + std::to_string(done) + " of " +
-               std::to_string(total) + " frames)";
+    const auto m = vision::metrics_before_start(
+        options, o.source, true,
+        "preparing the camera: rendering its video once into " + fixture_cache_dir().string() +
+            " (" + std::to_string(done) + " of " + std::to_string(total) + " frames)");
     emit(vision::heartbeat_message(m, clock.utc_now()));
   };
   try {

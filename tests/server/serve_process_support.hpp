@@ -7,6 +7,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <mutex>
@@ -18,16 +19,21 @@
 namespace gbdcs::server::testing {
 
 struct ServeProcess {
-  // `extra` go after the defaults (an option given twice: CLI11 takes the last).
-  ServeProcess(const std::string& db, const std::vector<std::string>& extra) {
+  // `extra` go after the defaults; CLI11 refuses an option given twice, so `source` replaces
+  // the default camera (empty: the demo flight's timeline), and a --worker-silence in `extra`
+  // replaces the default 1 s.
+  ServeProcess(const std::string& db, const std::vector<std::string>& extra,
+               std::string source = {}) {
     int out[2];
     if (pipe(out) != 0) throw std::runtime_error("pipe");
     const std::string bin = GBDCS_BINARY;
-    const std::string src =
-        std::string("timeline:") + GBDCS_SOURCE_DIR + "/fixtures/timelines/demo_flight.json";
+    if (source.empty())
+      source = std::string("timeline:") + GBDCS_SOURCE_DIR + "/fixtures/timelines/demo_flight.json";
     std::vector<std::string> args = {bin,   "serve", "--port", "0",    "--db",         db,
-                                     "--source", src, "--web",  "/nonexistent", "--log-json",
-                                     "--worker-silence", "1"};
+                                     "--source", source, "--web",  "/nonexistent", "--log-json"};
+    if (std::find(extra.begin(), extra.end(), "--worker-silence") == extra.end()) {
+      args.insert(args.end(), {"--worker-silence", "1"});
+    }
     args.insert(args.end(), extra.begin(), extra.end());
     pid = fork();
     if (pid == 0) {

@@ -8,6 +8,8 @@
 
 #include <cstdio>
 #include <fstream>
+#include <set>
+#include <string>
 
 #include "serve_process_support.hpp"
 
@@ -71,6 +73,53 @@ TEST(ServeProcess, WorkerKilledMidFlightMeansHoverAlertAndRestart) {
   auto now_children = serve.children();
   ASSERT_EQ(now_children.size(), 1u);
   EXPECT_NE(now_children[0], workers[0]);
+}
+
+// A recipe camera whose video is not cached yet is rendered first. Meanwhile the worker's
+// heartbeats say so (not healthy, counting frames): the server takes them (none rejected as
+// malformed, so its supervisor hears a live worker), the state shows the progress, take-off
+// stays locked, and vision becomes healthy once the video plays.
+TEST(ServeProcess, ARecipeCameraBeingRenderedIsShownAndThenPlays) {
+  TempDir dir;
+  const auto cache = dir.path() / "cache";
+  ASSERT_EQ(setenv("GBDCS_FIXTURE_CACHE", cache.c_str(), 1), 0);  // the worker inherits it
+  const std::string recipe = std::string("recipe:") + GBDCS_SOURCE_DIR +
+                             "/tests/fixtures_suite/small_recipe.json?live=1&fps=30";
+  ServeProcess serve((dir.path() / "gbdcs.db").string(),
+                     {"--adapter", "dummy", "--worker-silence", "2"}, recipe);
+  unsetenv("GBDCS_FIXTURE_CACHE");
+  ASSERT_GT(serve.port, 0);
+  const json creds = {{"email", "pilot@example.com"}, {"password", "correct horse battery"}};
+  ASSERT_EQ(http_call(serve.port, "POST", "/api/v1/auth/register", creds.dump()).status, 201);
+  const auto token = http_call(serve.port, "POST", "/api/v1/auth/login", creds.dump()).doc()["token"].get<std::string>();
+  WsClient ws;
+  ws.connect(serve.port, "/ws/live?token=" + token);
+
+  std::set<std::string> progress;  // the distinct "preparing" reasons seen
+  bool healthy_after = false;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  while (std::chrono::steady_clock::now() < deadline) {
+    auto m = ws.next(60);
+    if (!m) break;
+    if ((*m)["type"] != "state") continue;
+    const auto& vision = (*m)["data"]["vision"];
+    const auto reason = vision["reason"].get<std::string>();
+    if (reason.rfind("preparing the camera", 0) == 0) {
+      EXPECT_FALSE(vision["healthy"].get<bool>()) << reason;
+      EXPECT_FALSE(vision["ready"].get<bool>()) << reason;  // take-off is locked
+      progress.insert(reason);
+    }
+    if (vision["healthy"] == true && vision["ready"] == true) {  // the video plays
+      healthy_after = true;
+      break;
+    }
+  }
+  // The first heartbeat (frame 1) and the last (every frame) at least: the reason follows.
+  EXPECT_GE(progress.size(), 2u);
+  EXPECT_TRUE(healthy_after);
+  EXPECT_TRUE(serve.log_lines("worker_bad_message").empty()) << serve.log_lines("worker_bad_message")[0];
+  EXPECT_TRUE(serve.log_lines("VISION_WORKER_LOST").empty());
+  EXPECT_TRUE(std::filesystem::exists(cache));
 }
 
 }  // namespace

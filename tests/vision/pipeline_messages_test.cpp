@@ -103,6 +103,36 @@ TEST(VisionMessages, HeartbeatMatchesItsSchema) {
   EXPECT_FALSE(contracts::violations("vision_heartbeat", broken).empty());
 }
 
+// Before a pipeline exists (its camera still being prepared) the worker still owes the server
+// heartbeats it accepts: not healthy, with the reason, the queues at the capacity they will
+// have. A default PipelineMetrics is not one (its queues' capacity is 0).
+TEST(VisionMessages, HeartbeatBeforeStartMatchesItsSchema) {
+  const contracts::UtcTime at{std::chrono::milliseconds{1'767'225'600'000}};
+  EXPECT_FALSE(contracts::violations("vision_heartbeat", heartbeat_message(PipelineMetrics{}, at))
+                   .empty());
+
+  PipelineOptions options;
+  options.queue_capacity = 3;
+  const auto m = metrics_before_start(options, "recipe:demo.json?live=1", true,
+                                      "preparing the camera: 4 of 150 frames");
+  const auto doc = heartbeat_message(m, at);
+  EXPECT_TRUE(contracts::violations("vision_heartbeat", doc).empty())
+      << joined(contracts::violations("vision_heartbeat", doc)) << doc.dump(1);
+  EXPECT_EQ(doc["healthy"], false);
+  EXPECT_EQ(doc["running"], false);
+  EXPECT_EQ(doc["reason"], "preparing the camera: 4 of 150 frames");
+  EXPECT_EQ(doc["source"], "recipe:demo.json?live=1");
+  for (const char* q : {"preprocess", "landmarks", "classify"}) {
+    EXPECT_EQ(doc["queues"][q]["capacity"], 3) << q;
+    EXPECT_EQ(doc["queues"][q]["depth"], 0) << q;
+  }
+  EXPECT_EQ(m.policy, OverflowPolicy::kDropOldest);  // auto, for a live source
+  EXPECT_EQ(metrics_before_start(options, "video:a.mp4", false, "").policy, OverflowPolicy::kBlock);
+
+  options.queue_capacity = 0;
+  EXPECT_THROW(metrics_before_start(options, "camera:0", true, ""), std::invalid_argument);
+}
+
 TEST(RecognitionRecords, RoundTripAndReadTheReferenceFormat) {
   RecognizedImage ours;
   ours.image = "dir/a.jpg";

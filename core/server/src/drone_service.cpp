@@ -235,7 +235,7 @@ void DroneService::on_vision_health(bool healthy, const std::string& reason) {
   bool changed;
   {
     std::lock_guard s(status_mutex_);
-    changed = healthy != vision_healthy_;
+    changed = healthy != vision_healthy_ || reason != vision_reason_;  // both are shown
     vision_healthy_ = healthy;
     vision_reason_ = reason;
   }

@@ -54,6 +54,11 @@ const PipelineOptions& checked(const PipelineOptions& options) {
   return options;
 }
 
+// "auto" (no policy given): drop the oldest frame for a live source, block for a file.
+OverflowPolicy overflow_policy(const PipelineOptions& options, bool live) {
+  return options.policy.value_or(live ? OverflowPolicy::kDropOldest : OverflowPolicy::kBlock);
+}
+
 CaptureSource& non_null(const std::unique_ptr<CaptureSource>& source) {
   if (!source) throw std::invalid_argument("VisionPipeline: no capture source");
   return *source;
@@ -120,8 +125,7 @@ VisionPipeline::VisionPipeline(std::unique_ptr<CaptureSource> source,
       on_result_(std::move(on_result)),
       live_(non_null(source_).live()),
       source_name_(source_->describe()),
-      policy_(
-          options_.policy.value_or(live_ ? OverflowPolicy::kDropOldest : OverflowPolicy::kBlock)),
+      policy_(overflow_policy(options_, live_)),
       classifier_(options_.recognizer),
       engine_(clock, std::make_unique<ClassifierRecognizer>(classifier_), options_.engine),
       to_preprocess_(static_cast<std::size_t>(options_.queue_capacity), policy_),
@@ -304,6 +308,19 @@ void VisionPipeline::classify_loop() {
     }
     on_result_(r);
   }
+}
+
+PipelineMetrics metrics_before_start(const PipelineOptions& options, std::string source,
+                                     bool live, std::string reason) {
+  validate(options);
+  PipelineMetrics m;
+  m.healthy = false;
+  m.reason = std::move(reason);
+  m.source = std::move(source);
+  m.live = live;
+  m.policy = overflow_policy(options, live);
+  for (auto& q : m.queues) q.capacity = static_cast<std::size_t>(options.queue_capacity);
+  return m;
 }
 
 PipelineMetrics VisionPipeline::metrics() const {

@@ -154,6 +154,13 @@ struct PipelineOptions {
 PipelineOptions pipeline_options_from_json(const nlohmann::json& doc);  // validates
 void validate(const PipelineOptions& options);  // throws std::invalid_argument naming the key
 
+// The metrics of a pipeline that is not running yet (its camera still being prepared, say):
+// not healthy, for `reason`; the queues empty, at the capacity `options` will give them. What
+// a worker reports in its heartbeat before it has a pipeline (vision_heartbeat wants every
+// queue's capacity >= 1).
+PipelineMetrics metrics_before_start(const PipelineOptions& options, std::string source,
+                                     bool live, std::string reason);
+
 class VisionPipeline {
  public:
   using ResultCallback = std::function<void(const FrameResult&)>;
