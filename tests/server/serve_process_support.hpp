@@ -37,6 +37,7 @@ struct ServeProcess {
     args.insert(args.end(), extra.begin(), extra.end());
     pid = fork();
     if (pid == 0) {
+      setpgid(0, 0);  // its own group, as a shell gives a command: interrupt_group()
       dup2(out[1], 1);
       close(out[0]);
       std::vector<char*> argv;
@@ -75,6 +76,18 @@ struct ServeProcess {
     if (sig == SIGKILL) {
       for (auto w : workers) kill(w, SIGKILL);
     }
+    if (drain.joinable()) drain.join();
+    fclose(stream);
+    return status;
+  }
+
+  // A Ctrl-C on the terminal: SIGINT to the server's whole process group. Returns the wait
+  // status.
+  int interrupt_group() {
+    if (stopped) return status;
+    stopped = true;
+    kill(-pid, SIGINT);
+    waitpid(pid, &status, 0);
     if (drain.joinable()) drain.join();
     fclose(stream);
     return status;

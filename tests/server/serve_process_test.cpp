@@ -75,6 +75,44 @@ TEST(ServeProcess, WorkerKilledMidFlightMeansHoverAlertAndRestart) {
   EXPECT_NE(now_children[0], workers[0]);
 }
 
+// A Ctrl-C on the terminal (SIGINT to the foreground process group) stops the server, which
+// stops its worker: the worker is not reported lost on the way down, and the server exits 0.
+TEST(ServeProcess, CtrlCStopsTheServerAndItsWorkerInOrder) {
+  TempDir dir;
+  ServeProcess serve((dir.path() / "gbdcs.db").string(), {"--adapter", "dummy"});
+  ASSERT_GT(serve.port, 0);
+  const json creds = {{"email", "pilot@example.com"}, {"password", "correct horse battery"}};
+  ASSERT_EQ(http_call(serve.port, "POST", "/api/v1/auth/register", creds.dump()).status, 201);
+  const auto token = http_call(serve.port, "POST", "/api/v1/auth/login", creds.dump()).doc()["token"].get<std::string>();
+  WsClient ws;
+  ws.connect(serve.port, "/ws/live?token=" + token);
+  bool ready = false;
+  while (auto m = ws.next(20)) {
+    if ((*m)["type"] == "state" && (*m)["data"]["vision"]["ready"] == true) {
+      ready = true;
+      break;
+    }
+  }
+  ASSERT_TRUE(ready);
+  const auto workers = serve.children();
+  ASSERT_EQ(workers.size(), 1u);
+  // Which process exits first after a group-wide SIGINT is a race; this is why it is not one.
+  EXPECT_NE(getpgid(workers[0]), getpgid(serve.pid))
+      << "the worker is in the server's process group: a Ctrl-C reaches it directly";
+
+  const auto stop_started = std::chrono::steady_clock::now();
+  const int status = serve.interrupt_group();
+  const double stop_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - stop_started).count();
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "wait status " << status;
+  EXPECT_TRUE(serve.log_lines("worker_lost").empty()) << serve.log_lines("worker_lost")[0];
+  EXPECT_TRUE(serve.log_lines("VISION_WORKER_LOST").empty());
+  EXPECT_FALSE(serve.log_lines("stopping").empty());
+  EXPECT_NE(kill(workers[0], 0), 0) << "the worker outlived the server";
+  // Nothing after the stop re-arms vision: the worker's last frames were handled as they came.
+  EXPECT_TRUE(serve.log_lines("VISION_RESTORED").empty()) << serve.log_lines("VISION_RESTORED")[0];
+  std::printf("Ctrl-C -> server exited: %.2f s\n", stop_s);
+}
+
 // A recipe camera whose video is not cached yet is rendered first. Meanwhile the worker's
 // heartbeats say so (not healthy, counting frames): the server takes them (none rejected as
 // malformed, so its supervisor hears a live worker), the state shows the progress, take-off

@@ -34,8 +34,12 @@ void WorkerSupervisor::spawn_locked() {
   const pid_t parent = getpid();
   const pid_t child = fork();
   if (child == 0) {
-    // Only async-signal-safe calls between fork and exec. Die with the server.
+    // Only async-signal-safe calls between fork and exec. Die with the server. Its own
+    // process group: a Ctrl-C on the terminal (SIGINT to the foreground group) reaches only
+    // the server, which stops the worker in order, instead of the worker dying first and
+    // being reported lost (VISION_WORKER_LOST, HOVER) by a server on its way down.
     prctl(PR_SET_PDEATHSIG, SIGTERM);
+    setpgid(0, 0);
     if (getppid() != parent) _exit(127);
     execv(argv[0], argv.data());
     _exit(127);
@@ -153,20 +157,28 @@ void WorkerSupervisor::stop() {
   const bool was = running_.exchange(false);
   if (thread_.joinable()) thread_.join();
   if (!was) return;
-  std::lock_guard lock(mutex_);
-  if (pid_ > 0) {
-    kill(pid_, SIGTERM);
-    for (int i = 0; i < 200; ++i) {
-      if (waitpid(pid_, nullptr, WNOHANG) == pid_) {
-        pid_ = -1;
-        return;
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    }
-    kill(pid_, SIGKILL);
-    waitpid(pid_, nullptr, 0);
-    pid_ = -1;
+  pid_t pid;
+  {
+    std::lock_guard lock(mutex_);
+    pid = pid_;
   }
+  if (pid <= 0) return;
+  // Waited for outside the lock: the worker's last messages and the close of its socket are
+  // still taken (on_message, on_disconnected) while it exits. Holding the lock here blocked the
+  // server's I/O thread, so the worker's close went unanswered until the SIGKILL, 2 s later,
+  // and its last frame was handled only then.
+  kill(pid, SIGTERM);
+  bool reaped = false;
+  for (int i = 0; i < 200 && !reaped; ++i) {
+    reaped = waitpid(pid, nullptr, WNOHANG) == pid;
+    if (!reaped) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  if (!reaped) {
+    kill(pid, SIGKILL);
+    waitpid(pid, nullptr, 0);
+  }
+  std::lock_guard lock(mutex_);
+  pid_ = -1;
 }
 
 }  // namespace gbdcs::server
