@@ -190,13 +190,25 @@ int run_serve(ServeOptions o) {
   // What the drone service was last told of vision. A heartbeat passes on a change of it: of
   // health (both ways), or of the reason while unhealthy (the camera's preparation counts its
   // frames). Told under the lock, so a worker's loss and a heartbeat cannot cross.
+  // Health comes only from the pipeline's heartbeats (and a worker's loss), not from a new
+  // worker's first message: one that cannot open its camera says so, then exits.
   std::mutex vision_told_mutex;
   std::optional<std::pair<bool, std::string>> vision_told;
+  std::string worker_said;  // the current worker's last "not healthy" reason
   auto tell_vision = [&](bool healthy, const std::string& reason) {
     std::lock_guard lock(vision_told_mutex);
     if (vision_told && vision_told->first == healthy && vision_told->second == reason) return;
     vision_told.emplace(healthy, reason);
     drone.on_vision_health(healthy, reason);
+  };
+  auto heard_worker_say = [&](const std::string& reason) {
+    std::lock_guard lock(vision_told_mutex);
+    worker_said = reason;
+  };
+  // Why a worker was lost, with what it last said was wrong (the camera it could not open).
+  auto loss_cause = [&](const std::string& why) {
+    std::lock_guard lock(vision_told_mutex);
+    return worker_said.empty() ? why : why + " (it said: " + worker_said + ")";
   };
   if (!o.no_worker) {
     server::WorkerOptions wo;
@@ -208,18 +220,19 @@ int run_serve(ServeOptions o) {
     supervisor = std::make_unique<server::WorkerSupervisor>(
         clock, wo,
         [&](const std::string& why) {
+          const auto cause = loss_cause(why);
           // HOVER first (the failsafe does it on unhealthy vision while flying), then the alert.
-          tell_vision(false, why);
+          tell_vision(false, cause);
           contracts::Alert a;
           a.severity = contracts::Severity::kCritical;
           a.code = "VISION_WORKER_LOST";
-          a.cause = why;
+          a.cause = cause;
           a.suggestion = "the drone was told to hover; the worker is being restarted. Land with "
                          "the keyboard (l) if it does not come back";
           drone.raise_alert(a);
           http.metrics().worker_restarts++;
         },
-        [&] { tell_vision(true, ""); }, log);
+        [&] { heard_worker_say(""); }, log);
     http.set_worker_handlers(
         {[&] { supervisor->on_connected(); },
          [&](const json& msg) {
@@ -228,7 +241,9 @@ int run_serve(ServeOptions o) {
              fps = msg.value("fps", 0.0);
              // The pipeline's own verdict.
              const bool healthy = msg.value("healthy", true);
-             tell_vision(healthy, healthy ? "" : msg.value("reason", ""));
+             const std::string reason = healthy ? "" : msg.value("reason", "");
+             heard_worker_say(reason);
+             tell_vision(healthy, reason);
              return;
            }
            if (msg["type"] == "picture") {

@@ -97,6 +97,16 @@ int run_vision(const VisionOptions& o) {
             " (" + std::to_string(done) + " of " + std::to_string(total) + " frames)");
     emit(vision::heartbeat_message(m, clock.utc_now()));
   };
+  // The camera or the models cannot be opened: exit 2, and a server is told why in a last
+  // heartbeat (it shows that, not only that the worker's socket closed).
+  auto cannot_start = [&](const std::exception& e) {
+    std::cerr << "gbdcs vision: " << e.what() << "\n";
+    if (publisher) {
+      emit(vision::heartbeat_message(
+          vision::metrics_before_start(options, o.source, true, e.what()), clock.utc_now()));
+    }
+    return 2;
+  };
   try {
     source = o.source.rfind("recipe:", 0) == 0 ? open_recipe_source(o.source, clock, preparing)
                                                 : open_any_source(o.source, clock);
@@ -111,11 +121,9 @@ int run_vision(const VisionOptions& o) {
     const bool stills = o.source.rfind("images:", 0) == 0;
     finder = vision::make_tracker_finder(tracker_options(o.models, stills), clock);
   } catch (const vision::CaptureError& e) {
-    std::cerr << "gbdcs vision: " << e.what() << "\n";
-    return 2;
+    return cannot_start(e);
   } catch (const vision::ModelError& e) {
-    std::cerr << "gbdcs vision: " << e.what() << "\n";
-    return 2;
+    return cannot_start(e);
   }
 
   vision::VisionPipeline pipeline(

@@ -113,6 +113,44 @@ TEST(ServeProcess, CtrlCStopsTheServerAndItsWorkerInOrder) {
   std::printf("Ctrl-C -> server exited: %.2f s\n", stop_s);
 }
 
+// A camera that cannot be opened: the worker says why before it exits, and the dashboard's
+// state and the VISION_WORKER_LOST alert carry that (not only "its connection closed"). Vision
+// never turns healthy in between (no VISION_RESTORED at each restart).
+TEST(ServeProcess, ACameraThatCannotOpenIsNamedInTheStateAndTheAlert) {
+  TempDir dir;
+  ServeProcess serve((dir.path() / "gbdcs.db").string(), {"--adapter", "dummy"}, "camera:99");
+  ASSERT_GT(serve.port, 0);
+  const json creds = {{"email", "pilot@example.com"}, {"password", "correct horse battery"}};
+  ASSERT_EQ(http_call(serve.port, "POST", "/api/v1/auth/register", creds.dump()).status, 201);
+  const auto token = http_call(serve.port, "POST", "/api/v1/auth/login", creds.dump()).doc()["token"].get<std::string>();
+  WsClient ws;
+  ws.connect(serve.port, "/ws/live?token=" + token);
+
+  const std::string cause = "cannot open camera 99";
+  bool in_state = false, in_alert = false;
+  int lost_alerts = 0;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while ((!in_state || !in_alert || lost_alerts < 2) && std::chrono::steady_clock::now() < deadline) {
+    auto m = ws.next(10);
+    if (!m) break;
+    const auto& data = (*m)["data"];
+    if ((*m)["type"] == "state") {
+      EXPECT_FALSE(data["vision"]["healthy"] == true && data["vision"]["ready"] == true);
+      if (data["vision"]["reason"].get<std::string>().find(cause) != std::string::npos) in_state = true;
+    }
+    if ((*m)["type"] == "alert") {
+      EXPECT_NE(data["code"], "VISION_RESTORED") << data.dump();
+      if (data["code"] == "VISION_WORKER_LOST") {
+        ++lost_alerts;
+        if (data["cause"].get<std::string>().find(cause) != std::string::npos) in_alert = true;
+      }
+    }
+  }
+  EXPECT_TRUE(in_state) << "the state's vision.reason never named the camera";
+  EXPECT_TRUE(in_alert) << "no VISION_WORKER_LOST alert named the camera";
+  EXPECT_GE(lost_alerts, 2) << "the worker was not restarted";
+}
+
 // A recipe camera whose video is not cached yet is rendered first. Meanwhile the worker's
 // heartbeats say so (not healthy, counting frames): the server takes them (none rejected as
 // malformed, so its supervisor hears a live worker), the state shows the progress, take-off
