@@ -126,6 +126,21 @@ TEST(ServerRoutes, ConfigSessionsTelemetryEmergencyHealthMetrics) {
                          token),
                400, "invalid_body");
 
+  // Bad options for a known adapter: 400 naming them, and nothing changes — the connected
+  // drone and its session stay, nothing is stored for the next start, the theme is not set.
+  r = http_call(s.port, "PUT", "/api/v1/config",
+                json{{"theme", "light"},
+                     {"adapter", {{"name", "tello"}, {"options", {{"port", 1}}}}}}.dump(), token);
+  expect_error(r, 400, "invalid_body");
+  EXPECT_EQ(r.doc()["field"], "adapter.options");
+  EXPECT_NE(r.doc()["cause"].get<std::string>().find("'port' is not a known option"), std::string::npos)
+      << r.body;
+  EXPECT_EQ(s.drone->adapter_name(), "dummy");
+  EXPECT_EQ(s.drone->session_id(), first_session);
+  EXPECT_FALSE(s.storage.get_session(first_session)->ended_at.has_value());
+  EXPECT_FALSE(s.storage.get_config("adapter").has_value());
+  EXPECT_EQ(http_call(s.port, "GET", "/api/v1/config", "", token).doc()["theme"], "dark");
+
   // Adapter swap: the old session ends, a new one opens.
   r = http_call(s.port, "PUT", "/api/v1/config",
                 json{{"adapter", {{"name", "dummy"}, {"options", json::object()}}}}.dump(), token);

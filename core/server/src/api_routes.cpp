@@ -189,6 +189,13 @@ ApiResponse do_put_config(ApiContext& ctx, const ApiRequest& r, const TokenClaim
       throw ApiError(400, "invalid_body", "there is no drone adapter '" + name + "'",
                      "choose one of: " + list, "adapter.name");
     }
+    // Bad options are refused before anything changes: the connected drone stays, and nothing
+    // is stored for the next start.
+    if (auto bad = ctx.drone.check_adapter(name, body["adapter"]["options"]); !bad.empty()) {
+      throw ApiError(400, "invalid_body", bad,
+                     "fix the adapter's options (docs/ADAPTERS.md lists each adapter's)",
+                     "adapter.options");
+    }
   }
   if (body.contains("theme")) {
     ctx.storage.set_user_theme(who.user_id, body["theme"].get<std::string>());

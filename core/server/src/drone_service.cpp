@@ -137,6 +137,17 @@ void DroneService::stop_active_locked() {
   active_.reset();
 }
 
+std::string DroneService::check_adapter(const std::string& name, const json& options) const {
+  try {
+    factory_(name, options.is_object() ? options : json::object());
+  } catch (const std::invalid_argument& e) {
+    return std::string("cannot create the '") + name + "' drone: " + e.what();
+  } catch (const std::exception&) {
+    // Not the options' fault (a socket in use, say): connect() reports it if it lasts.
+  }
+  return {};
+}
+
 std::string DroneService::connect(const std::string& name, const json& options) {
   std::unique_lock lock(active_mutex_);
   stop_active_locked();

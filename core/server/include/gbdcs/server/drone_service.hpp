@@ -67,6 +67,11 @@ class DroneService {
 
   // "" when connected; otherwise the error (the service then runs without a drone).
   std::string connect(const std::string& name, const nlohmann::json& options);
+  // Whether `options` make a `name` drone, asked before connect() lets the current one go: ""
+  // when they do (or when only the swap can tell: the adapter could not be made for another
+  // reason, such as sockets the connected drone holds), else why not (an unknown adapter, an
+  // unknown or bad option). Makes an adapter and drops it; connects nothing.
+  std::string check_adapter(const std::string& name, const nlohmann::json& options) const;
   void disconnect();
 
   void on_vision_frame(const nlohmann::json& frame_message);
