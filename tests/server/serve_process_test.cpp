@@ -16,15 +16,20 @@
 namespace gbdcs::server::testing {
 namespace {
 
+// An operator registered and logged in, watching /ws/live.
+void open_live(const ServeProcess& serve, WsClient& ws) {
+  const json creds = {{"email", "pilot@example.com"}, {"password", "correct horse battery"}};
+  ASSERT_EQ(http_call(serve.port, "POST", "/api/v1/auth/register", creds.dump()).status, 201);
+  const auto token = http_call(serve.port, "POST", "/api/v1/auth/login", creds.dump()).doc()["token"].get<std::string>();
+  ws.connect(serve.port, "/ws/live?token=" + token);
+}
+
 TEST(ServeProcess, WorkerKilledMidFlightMeansHoverAlertAndRestart) {
   TempDir dir;
   ServeProcess serve((dir.path() / "gbdcs.db").string(), {"--adapter", "dummy"});
   ASSERT_GT(serve.port, 0);
-  const json creds = {{"email", "pilot@example.com"}, {"password", "correct horse battery"}};
-  ASSERT_EQ(http_call(serve.port, "POST", "/api/v1/auth/register", creds.dump()).status, 201);
-  const auto token = http_call(serve.port, "POST", "/api/v1/auth/login", creds.dump()).doc()["token"].get<std::string>();
   WsClient ws;
-  ws.connect(serve.port, "/ws/live?token=" + token);
+  ASSERT_NO_FATAL_FAILURE(open_live(serve, ws));
 
   // Fly: the timeline's THUMB_UP takes off.
   bool flying = false;
@@ -81,11 +86,8 @@ TEST(ServeProcess, CtrlCStopsTheServerAndItsWorkerInOrder) {
   TempDir dir;
   ServeProcess serve((dir.path() / "gbdcs.db").string(), {"--adapter", "dummy"});
   ASSERT_GT(serve.port, 0);
-  const json creds = {{"email", "pilot@example.com"}, {"password", "correct horse battery"}};
-  ASSERT_EQ(http_call(serve.port, "POST", "/api/v1/auth/register", creds.dump()).status, 201);
-  const auto token = http_call(serve.port, "POST", "/api/v1/auth/login", creds.dump()).doc()["token"].get<std::string>();
   WsClient ws;
-  ws.connect(serve.port, "/ws/live?token=" + token);
+  ASSERT_NO_FATAL_FAILURE(open_live(serve, ws));
   bool ready = false;
   while (auto m = ws.next(20)) {
     if ((*m)["type"] == "state" && (*m)["data"]["vision"]["ready"] == true) {
@@ -120,11 +122,8 @@ TEST(ServeProcess, ACameraThatCannotOpenIsNamedInTheStateAndTheAlert) {
   TempDir dir;
   ServeProcess serve((dir.path() / "gbdcs.db").string(), {"--adapter", "dummy"}, "camera:99");
   ASSERT_GT(serve.port, 0);
-  const json creds = {{"email", "pilot@example.com"}, {"password", "correct horse battery"}};
-  ASSERT_EQ(http_call(serve.port, "POST", "/api/v1/auth/register", creds.dump()).status, 201);
-  const auto token = http_call(serve.port, "POST", "/api/v1/auth/login", creds.dump()).doc()["token"].get<std::string>();
   WsClient ws;
-  ws.connect(serve.port, "/ws/live?token=" + token);
+  ASSERT_NO_FATAL_FAILURE(open_live(serve, ws));
 
   const std::string cause = "cannot open camera 99";
   bool in_state = false, in_alert = false;
@@ -165,11 +164,8 @@ TEST(ServeProcess, ARecipeCameraBeingRenderedIsShownAndThenPlays) {
                      {"--adapter", "dummy", "--worker-silence", "2"}, recipe);
   unsetenv("GBDCS_FIXTURE_CACHE");
   ASSERT_GT(serve.port, 0);
-  const json creds = {{"email", "pilot@example.com"}, {"password", "correct horse battery"}};
-  ASSERT_EQ(http_call(serve.port, "POST", "/api/v1/auth/register", creds.dump()).status, 201);
-  const auto token = http_call(serve.port, "POST", "/api/v1/auth/login", creds.dump()).doc()["token"].get<std::string>();
   WsClient ws;
-  ws.connect(serve.port, "/ws/live?token=" + token);
+  ASSERT_NO_FATAL_FAILURE(open_live(serve, ws));
 
   std::set<std::string> progress;  // the distinct "preparing" reasons seen
   bool healthy_after = false;
