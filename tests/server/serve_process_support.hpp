@@ -66,12 +66,13 @@ struct ServeProcess {
   ~ServeProcess() { stop(SIGTERM); }
 
   // Stops the server with `sig` (SIGKILL: no clean-up at all) and, after SIGKILL, its worker
-  // too (an orphan would keep trying to reconnect). Returns the wait status.
-  int stop(int sig) {
+  // too (an orphan would keep trying to reconnect); `whole_group`: to the server's process
+  // group. Returns the wait status.
+  int stop(int sig, bool whole_group = false) {
     if (stopped) return status;
     stopped = true;
     const auto workers = children();
-    kill(pid, sig);
+    kill(whole_group ? -pid : pid, sig);
     waitpid(pid, &status, 0);
     if (sig == SIGKILL) {
       for (auto w : workers) kill(w, SIGKILL);
@@ -83,15 +84,7 @@ struct ServeProcess {
 
   // A Ctrl-C on the terminal: SIGINT to the server's whole process group. Returns the wait
   // status.
-  int interrupt_group() {
-    if (stopped) return status;
-    stopped = true;
-    kill(-pid, SIGINT);
-    waitpid(pid, &status, 0);
-    if (drain.joinable()) drain.join();
-    fclose(stream);
-    return status;
-  }
+  int interrupt_group() { return stop(SIGINT, true); }
 
   std::vector<pid_t> children() const {
     std::vector<pid_t> out;
